@@ -1,0 +1,130 @@
+"""Every parameter of the patrolling environment in one frozen dataclass.
+
+Defaults follow the paper and ``SPEC.md``; unknown keys are refused loudly.
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import Optional
+
+ENV_VERSION = "patrol_v1"
+"""Version of the environment's rules; checkpoints record it and refuse a mismatch."""
+
+COMM_MODES = ("none", "learned", "intention")
+MESSAGE_TIMINGS = ("same_step", "delayed")
+INVALID_ACTION_MODES = ("raise", "stay")
+
+# Per-map parameter changes taken from the paper (c_pbb is 0.5 on map B).
+MAP_OVERRIDES = {"B": {"c_pbb": 0.5}}
+
+
+@dataclasses.dataclass(frozen=True)
+class EnvConfig:
+    """Parameters of the patrolling world. Units: one step = ``step_minutes`` minutes; one
+    battery unit = the nominal drain of one step."""
+
+    max_agents: int = 5
+    """Number of agent slots; observations and the critic state are padded to it."""
+    episode_steps: int = 5000
+    """Simulator steps per episode (truncation). Evaluation uses 14,400 (24 h)."""
+    step_minutes: float = 0.1
+    """Duration of one step in minutes (a 50 m cell at about 8.3 m/s)."""
+
+    b_max: float = 550.0
+    """Battery capacity in units (one unit = nominal drain of one step)."""
+    init_battery: tuple = (0.9, 1.0)
+    """Initial battery drawn uniformly in this range, as fractions of b_max."""
+    drain: tuple = (0.9, 1.1)
+    """Drain per step of an active agent, uniform in this range (units)."""
+    push_drain_factor: float = 1.5
+    """A pushed agent's drain is multiplied by this factor (fighting the wind)."""
+    p_dyn_max: float = 0.05
+    """Each agent's push probability p_dyn is drawn per episode from U[0, p_dyn_max]."""
+    swap_time: tuple = (80, 150)
+    """Hot-swap duration in steps, an integer drawn uniformly in [low, high] per swap."""
+    b_low_frac: float = 0.2
+    """b_l as a fraction of b_max: below it the battery penalty applies; heuristics plan
+    to reach the station with about this much left."""
+
+    c_norm: float = 200.0
+    """Idleness normalisation f(i) = 1 - exp(-i / c_norm)."""
+    c_rp: float = 0.5
+    """Weight of the team patrol reward R'_p."""
+    c_d: Optional[float] = None
+    """Weight of the difference reward D_k; None means 50 / max_agents."""
+    c_pb: float = 50.0
+    """Penalty once when the battery runs out."""
+    c_pbb: float = 1.0
+    """Base of the low-battery penalty (0.5 on map B, see MAP_OVERRIDES)."""
+    c_pbm: float = 20.0
+    """Slope of the low-battery penalty: -(c_pbb + c_pbm (b_l - b) / b_l)."""
+    c_pc: float = 1.0
+    """Penalty to each agent in a collision event."""
+
+    n_symbols: int = 16
+    """Size of the message alphabet (symbols 1..n_symbols; 0 is silence)."""
+    comm: str = "learned"
+    """'learned' (RIAL messages), 'intention' (symbol = intended move + 1, fixed meaning)
+    or 'none' (positions only)."""
+    message_timing: str = "same_step"
+    """'same_step': a message phase precedes each move phase and everyone sees this step's
+    symbols before moving; 'delayed': message and move are chosen together and the symbols
+    are seen at the next step (classic RIAL)."""
+
+    fault_prob: float = 0.0
+    """Per-step probability that each active agent suffers a hardware failure."""
+    faults: tuple = ()
+    """Scheduled failures: a tuple of (step, k) pairs; at that step k active agents (chosen
+    at random) fail for good."""
+    invalid_action: str = "raise"
+    """What a masked (invalid) move does: 'raise' an error or be treated as 'stay'."""
+
+    def __post_init__(self):
+        if self.max_agents < 1:
+            raise ValueError(f"max_agents must be >= 1, got {self.max_agents}")
+        if self.comm not in COMM_MODES:
+            raise ValueError(f"comm must be one of {COMM_MODES}, got {self.comm!r}")
+        if self.message_timing not in MESSAGE_TIMINGS:
+            raise ValueError(f"message_timing must be one of {MESSAGE_TIMINGS}, got {self.message_timing!r}")
+        if self.invalid_action not in INVALID_ACTION_MODES:
+            raise ValueError(f"invalid_action must be one of {INVALID_ACTION_MODES}, got {self.invalid_action!r}")
+        if self.episode_steps < 1:
+            raise ValueError(f"episode_steps must be >= 1, got {self.episode_steps}")
+        if not 0.0 <= self.p_dyn_max <= 1.0:
+            raise ValueError(f"p_dyn_max must be in [0, 1], got {self.p_dyn_max}")
+        if self.swap_time[0] < 1 or self.swap_time[1] < self.swap_time[0]:
+            raise ValueError(f"swap_time must be (low, high) with 1 <= low <= high, got {self.swap_time}")
+        object.__setattr__(self, "faults", tuple(tuple(int(v) for v in f) for f in self.faults))
+
+    @property
+    def b_low(self) -> float:
+        """b_l in battery units."""
+        return self.b_low_frac * self.b_max
+
+    @property
+    def difference_weight(self) -> float:
+        """c_d with its default 50 / max_agents applied."""
+        return 50.0 / self.max_agents if self.c_d is None else self.c_d
+
+    def to_dict(self) -> dict:
+        """Plain dict (YAML/JSON friendly)."""
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in dataclasses.asdict(self).items()}
+
+
+def make_config(map_name: Optional[str] = None, **overrides) -> EnvConfig:
+    """Build an :class:`EnvConfig` with the paper's per-map values, then the caller's.
+
+    Args:
+        map_name: a shipped map name; its entries in MAP_OVERRIDES apply first.
+        **overrides: any EnvConfig field.
+
+    Raises:
+        TypeError: an unknown parameter name (the message lists the known ones).
+    """
+    known = {f.name for f in dataclasses.fields(EnvConfig)}
+    unknown = sorted(set(overrides) - known)
+    if unknown:
+        raise TypeError(f"unknown environment parameter(s) {unknown}; known: {sorted(known)}")
+    values = dict(MAP_OVERRIDES.get(str(map_name).upper(), {})) if map_name else {}
+    values.update({k: tuple(v) if isinstance(v, list) else v for k, v in overrides.items()})
+    return EnvConfig(**values)

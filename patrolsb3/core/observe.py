@@ -1,0 +1,100 @@
+"""Actor observations and the centralised critic state (SPEC.md section 3).
+
+Grid channel 0 (positions and messages), values divided by ``n_symbols + 2``:
+
+* vertex 0, obstacle -1, station +1;
+* an active agent with symbol ``m`` (0 = silent) is written on its cell as ``1 + m``, positive
+  for the observing agent itself and negative for the others, so all agent values lie
+  strictly inside (-1, 1) and never equal the station's or an obstacle's value;
+* others standing on a station are not drawn (the station is shared); an observer on a
+  station sees its own value there.
+
+Grid channel 1 (idleness): f(i) = 1 - exp(-i / c_norm) on vertices (1 if never visited),
+-1 on obstacles, 0 on stations.
+
+Vector: [own battery fraction, own move mask (5), phase (0 message, 1 move), active flag].
+
+Critic state: for every slot its battery fraction, row / (H-1) and col / (W-1); an absent
+or failed slot is padded with battery 1 and the station's position (the paper's padding).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .config import EnvConfig
+from .maps import OBSTACLE, STATION, MapSpec
+from .masks import action_mask
+from .reward import normalised_idleness
+from .state import ACTIVE, State
+
+VECTOR_SIZE = 8
+"""Length of the actor's vector observation."""
+
+
+def grid_size(spec: MapSpec) -> int:
+    """H * W."""
+    return spec.kinds.size
+
+
+def actor_observation(spec: MapSpec, cfg: EnvConfig, state: State, phase: int = 1,
+                      mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Every slot's view.
+
+    Args:
+        spec: the map.
+        cfg: environment parameters.
+        state: batched state.
+        phase: 0 in a message phase, 1 in a move phase.
+        mask: (E, A, 5) move mask if already computed.
+
+    Returns:
+        grid (E, A, 2, H, W) float32 and vector (E, A, VECTOR_SIZE) float32.
+    """
+    E, A = state.pos.shape
+    H, W = spec.shape
+    scale = float(cfg.n_symbols + 2)
+    kinds = spec.kinds.ravel()
+    base = np.where(kinds == OBSTACLE, -1.0, np.where(kinds == STATION, 1.0, 0.0)).astype(np.float32)
+    chan0 = np.broadcast_to(base, (E, A, H * W)).copy()                      # (E, A, H*W)
+    active = state.active
+    value = (1.0 + state.messages) / scale                                     # (E, A) slot j's value
+    on_station = (kinds == STATION)[state.pos]                                 # (E, A)
+    e_idx, i_idx, j_idx = np.meshgrid(np.arange(E), np.arange(A), np.arange(A), indexing="ij")
+    draw_other = (active[:, None, :] & ~on_station[:, None, :]) & (i_idx != j_idx)  # (E, A, A)
+    chan0[e_idx[draw_other], i_idx[draw_other], state.pos[e_idx[draw_other], j_idx[draw_other]]] = \
+        -value[e_idx[draw_other], j_idx[draw_other]]
+    e_s, i_s = np.nonzero(active)
+    chan0[e_s, i_s, state.pos[e_s, i_s]] = value[e_s, i_s]
+
+    f = normalised_idleness(state.idle, state.visited, cfg.c_norm)              # (E, V)
+    idle_grid = np.where(kinds == OBSTACLE, -1.0, 0.0).astype(np.float32)
+    chan1 = np.broadcast_to(idle_grid, (E, H * W)).copy()
+    chan1[:, spec.vertex_cells] = f
+    grid = np.empty((E, A, 2, H * W), dtype=np.float32)
+    grid[:, :, 0] = chan0
+    grid[:, :, 1] = chan1[:, None, :]
+
+    if mask is None:
+        mask = action_mask(spec, state)
+    vector = np.empty((E, A, VECTOR_SIZE), dtype=np.float32)
+    vector[..., 0] = state.battery / cfg.b_max
+    vector[..., 1:6] = mask
+    vector[..., 6] = phase
+    vector[..., 7] = active
+    return grid.reshape(E, A, 2, H, W), vector
+
+
+def critic_state(spec: MapSpec, cfg: EnvConfig, state: State) -> np.ndarray:
+    """Centralised information every slot's critic gets besides the actor view.
+
+    Returns:
+        (E, 3 * A) float32: battery fraction, row / (H-1), col / (W-1) of each slot.
+    """
+    E, A = state.pos.shape
+    H, W = spec.shape
+    present = state.status == ACTIVE
+    pos = np.where(present, state.pos, spec.station)
+    battery = np.where(present, state.battery / cfg.b_max, 1.0)
+    row, col = np.divmod(pos, W)
+    out = np.stack([battery, row / max(H - 1, 1), col / max(W - 1, 1)], axis=-1)  # (E, A, 3)
+    return out.reshape(E, 3 * A).astype(np.float32)

@@ -1,0 +1,253 @@
+"""One simulator step for a batch of episodes, in the order of SPEC.md section 2:
+
+messages -> moves (checked against the mask) -> pushes -> collisions -> battery drain ->
+idleness -> hot swaps -> failures -> rewards.
+
+Documented choices (where the paper is silent):
+
+* Pushes: with probability ``p_dyn`` an active agent moves one cell in a uniformly random
+  direction (Up/Down/Left/Right) instead of its chosen move; a push into an obstacle or the
+  border leaves it in place. A pushed target ignores the mask (the wind does not look).
+* Collisions: a *swap* (two movers exchanging cells) is one event, both stay; a *contested
+  cell* (two or more movers heading for the same non-station cell) is one event, one mover
+  chosen uniformly at random gets it, the others stay. A mover whose target is held by an
+  agent that stays is blocked without an event (iterated until stable). Every agent in an
+  event gets the collision penalty. Stations hold any number of agents.
+* Battery: an active agent drains U[drain] units per step, x push_drain_factor when pushed.
+* A swap starts when an agent's own (not pushed) move takes it onto a station from another
+  cell; it lasts ``swap_time`` steps, offline; at the end of the last of them a fresh agent
+  (full battery) appears on that station. Arriving on purpose saves an agent whose battery
+  ran out on the same step (the swap comes before the failure check, as in SPEC order).
+* Faults: ``faults=((s, k), ...)`` makes k agents that exist (active or swapping, chosen at
+  random) fail at the end of step s (0-based); ``fault_prob`` fails each active agent with
+  that probability per step.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from .config import EnvConfig
+from .maps import ACTION_NAMES, STAY, MapSpec
+from .masks import action_mask, station_cells
+from .reward import (battery_reward, collision_reward, difference_reward, normalised_idleness,
+                     team_patrol_reward)
+from .state import ACTIVE, FAILED, SWAPPING, State
+
+
+class InvalidActionError(ValueError):
+    """A move that the action mask forbids reached the simulator."""
+
+
+@dataclasses.dataclass
+class StepInfo:
+    """What happened in one step of E episodes (A slots each)."""
+
+    reward: np.ndarray          # (E, A) float64 total reward R (0 for slots inactive at step start)
+    reward_patrol: np.ndarray   # (E, A) float64 R_p
+    reward_battery: np.ndarray  # (E, A) float64 R_b
+    reward_collision: np.ndarray  # (E, A) float64 R_c
+    acted: np.ndarray           # (E, A) bool, slot was active at the start of the step
+    pushed: np.ndarray          # (E, A) bool, moved by the wind instead of its move
+    collided: np.ndarray        # (E, A) bool, took part in a collision event
+    collisions: np.ndarray      # (E,) int64 collision events this step
+    swap_started: np.ndarray    # (E, A) bool
+    swap_battery: np.ndarray    # (E, A) float64 battery fraction at swap start (nan if none)
+    swap_ended: np.ndarray      # (E, A) bool, a fresh agent appeared on the station
+    battery_failed: np.ndarray  # (E, A) bool, failed because the battery ran out
+    fault_failed: np.ndarray    # (E, A) bool, failed by injected fault
+    team_patrol: np.ndarray     # (E,) float64 R'_p(t)
+    mean_idleness: np.ndarray   # (E,) float64 mean over vertices of the idleness after the step
+    max_idleness: np.ndarray    # (E,) float64 max over vertices of the idleness after the step
+    truncated: np.ndarray       # (E,) bool, the episode reached episode_steps
+    terminated: np.ndarray      # (E,) bool, every deployed agent has failed
+
+
+def check_moves(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray) -> np.ndarray:
+    """Validate moves against the action mask.
+
+    Args:
+        moves: (E, A) int action per slot (inactive slots are forced to Stay).
+
+    Returns:
+        (E, A) int64 moves, invalid ones replaced by Stay when cfg.invalid_action == 'stay'.
+
+    Raises:
+        InvalidActionError: a masked move when cfg.invalid_action == 'raise'.
+    """
+    moves = np.asarray(moves, dtype=np.int64)
+    if moves.shape != state.pos.shape:
+        raise ValueError(f"moves must have shape {state.pos.shape} (n_envs, max_agents), got {moves.shape}")
+    if ((moves < 0) | (moves > STAY)).any():
+        bad = moves[(moves < 0) | (moves > STAY)][0]
+        raise InvalidActionError(f"move {bad} outside 0..4 ({', '.join(ACTION_NAMES)})")
+    moves = np.where(state.active, moves, STAY)
+    mask = action_mask(spec, state)
+    ok = np.take_along_axis(mask, moves[..., None], axis=-1)[..., 0]
+    if not ok.all():
+        if cfg.invalid_action == "raise":
+            e, a = np.argwhere(~ok)[0]
+            r, c = spec.rowcol(state.pos[e, a])
+            raise InvalidActionError(
+                f"episode {e}, agent {a} at (row {r}, col {c}) chose {ACTION_NAMES[moves[e, a]]}, "
+                f"which its action mask forbids (blocked, obstacle or occupied); "
+                f"set invalid_action='stay' to treat masked moves as Stay")
+        moves = np.where(ok, moves, STAY)
+    return moves
+
+
+def resolve_collisions(spec: MapSpec, pos: np.ndarray, target: np.ndarray, active: np.ndarray,
+                       rng: np.random.Generator):
+    """Apply the collision rule to simultaneous moves.
+
+    Args:
+        pos: (E, A) current cells.
+        target: (E, A) cells the slots head for (their own cell when staying).
+        active: (E, A) bool, slots on the grid.
+        rng: draws the winner of each contested cell.
+
+    Returns:
+        new_pos (E, A), collided (E, A) bool, events (E,) int64.
+    """
+    E, A = pos.shape
+    on_station = station_cells(spec)[target]                              # (E, A)
+    moving = active & (target != pos)
+    # swap conflicts: i -> pos_j and j -> pos_i
+    swap = (moving[:, :, None] & moving[:, None, :]
+            & (target[:, :, None] == pos[:, None, :]) & (target[:, None, :] == pos[:, :, None]))
+    swapped = swap.any(axis=2)                                            # (E, A)
+    events = swap.sum(axis=(1, 2)) // 2
+    collided = swapped.copy()
+    moving &= ~swapped
+    # contested cells: two or more movers heading for the same non-station cell
+    same = (moving[:, :, None] & moving[:, None, :]
+            & (target[:, :, None] == target[:, None, :]) & ~on_station[:, :, None])  # (E, A, A)
+    contender = same.sum(axis=2) >= 2
+    if contender.any():
+        key = rng.random((E, A))
+        best = np.where(same, key[:, None, :], -1.0).max(axis=2)
+        loser = contender & (key < best)
+        lower = np.tril(np.ones((A, A), dtype=bool), -1)[None]           # j < i
+        first_of_cell = contender & ~(same & lower).any(axis=2)
+        events = events + first_of_cell.sum(axis=1)
+        collided |= contender
+        moving &= ~loser
+    # movers whose target is held by an agent that stays are blocked (until stable)
+    for _ in range(A):
+        stayer = active & ~moving
+        blocked = moving & ~on_station & (stayer[:, None, :]
+                                          & (pos[:, None, :] == target[:, :, None])).any(axis=2)
+        if not blocked.any():
+            break
+        moving &= ~blocked
+    new_pos = np.where(moving, target, pos)
+    return new_pos, collided, events.astype(np.int64)
+
+
+def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
+         messages: np.ndarray | None = None, compute_reward: bool = True) -> StepInfo:
+    """Advance every episode of ``state`` by one step, in place.
+
+    Args:
+        spec: the map.
+        cfg: environment parameters.
+        state: batched state, modified in place.
+        moves: (E, A) int moves (Up, Down, Left, Right, Stay = 0..4).
+        messages: (E, A) int symbols 0..n_symbols shown this step (0 = silent), or None to
+            keep ``state.messages`` (they are cleared for inactive slots).
+        compute_reward: skip the reward arithmetic when False (heuristic evaluation).
+
+    Returns:
+        A :class:`StepInfo`.
+    """
+    rng = state.rng
+    E, A = state.pos.shape
+    acted = state.active.copy()                                           # (E, A)
+    # 1. messages
+    if messages is not None:
+        state.messages = np.where(acted, np.asarray(messages, dtype=np.int64), 0)
+    else:
+        state.messages = np.where(acted, state.messages, 0)
+    # 2. moves, checked against the mask
+    moves = check_moves(spec, cfg, state, moves)
+    pos = state.pos
+    # 3. pushes by the environment
+    pushed = acted & (rng.random((E, A)) < state.p_dyn)
+    push_dir = rng.integers(0, 4, size=(E, A))
+    target = np.where(pushed, spec.neighbour[pos, push_dir], spec.neighbour[pos, moves])
+    # 4. collisions
+    new_pos, collided, collisions = resolve_collisions(spec, pos, target, acted, rng)
+    # 5. battery
+    drain = rng.uniform(cfg.drain[0], cfg.drain[1], size=(E, A))
+    drain = np.where(pushed, drain * cfg.push_drain_factor, drain)
+    state.battery = np.where(acted, state.battery - drain, state.battery)
+    # 6. idleness: grows by the rate, reset where active agents stand
+    state.idle += spec.rate
+    v_at = spec.vertex_of_cell[new_pos]                                    # (E, A) -1 off-vertex
+    on_vertex = acted & (v_at >= 0)
+    e_idx = np.broadcast_to(np.arange(E)[:, None], (E, A))
+    v_safe = np.maximum(v_at, 0)
+    idle_without_k = state.idle[e_idx, v_safe]                           # (E, A)
+    visited_without_k = state.visited[e_idx, v_safe]
+    state.idle[e_idx[on_vertex], v_at[on_vertex]] = 0.0
+    state.visited[e_idx[on_vertex], v_at[on_vertex]] = True
+    state.pos = new_pos
+    # 7. hot swaps: running swaps count down, then new arrivals on purpose start one
+    swapping = state.status == SWAPPING
+    state.swap_left = np.where(swapping, state.swap_left - 1, state.swap_left)
+    swap_ended = swapping & (state.swap_left <= 0)
+    state.status = np.where(swap_ended, ACTIVE, state.status).astype(np.int8)
+    state.battery = np.where(swap_ended, cfg.b_max, state.battery)
+    arrived = acted & ~pushed & (new_pos != pos) & station_cells(spec)[new_pos]
+    swap_battery = np.where(arrived, state.battery / cfg.b_max, np.nan)
+    state.status = np.where(arrived, SWAPPING, state.status).astype(np.int8)
+    durations = rng.integers(cfg.swap_time[0], cfg.swap_time[1] + 1, size=(E, A))
+    state.swap_left = np.where(arrived, durations, state.swap_left)
+    # 8. failures: empty battery, then injected faults
+    battery_failed = acted & ~arrived & (state.battery <= 0)
+    state.status = np.where(battery_failed, FAILED, state.status).astype(np.int8)
+    fault_failed = _inject_faults(cfg, state, rng)
+    reward_battery = battery_reward(state.battery, cfg) if compute_reward else None
+    state.battery = np.maximum(state.battery, 0.0)
+    state.t += 1
+    # rewards
+    if compute_reward:
+        f = normalised_idleness(state.idle, state.visited, cfg.c_norm)       # (E, V)
+        team, mean_f, max_f = team_patrol_reward(f)
+        f_without_k = np.where(visited_without_k, -np.expm1(-idle_without_k / cfg.c_norm), 1.0)
+        d = difference_reward(f_without_k, on_vertex, mean_f, max_f, spec.n_vertices)
+        reward_patrol = np.where(acted, cfg.c_rp * team[:, None] + cfg.difference_weight * d, 0.0)
+        reward_battery = np.where(acted, reward_battery, 0.0)
+        reward_collision = np.where(acted, collision_reward(collided, cfg), 0.0)
+        reward = reward_patrol + reward_battery + reward_collision
+    else:
+        team = np.full(E, np.nan)
+        reward = reward_patrol = reward_battery = reward_collision = np.zeros((E, A))
+    return StepInfo(
+        reward=reward, reward_patrol=reward_patrol, reward_battery=reward_battery,
+        reward_collision=reward_collision, acted=acted, pushed=pushed, collided=collided,
+        collisions=collisions, swap_started=arrived, swap_battery=swap_battery,
+        swap_ended=swap_ended, battery_failed=battery_failed, fault_failed=fault_failed,
+        team_patrol=team, mean_idleness=state.idle.mean(axis=1),
+        max_idleness=state.idle.max(axis=1), truncated=state.t >= cfg.episode_steps,
+        terminated=((state.status == FAILED) | (state.n_agents[:, None] <= np.arange(A))).all(axis=1))
+
+
+def _inject_faults(cfg: EnvConfig, state: State, rng: np.random.Generator) -> np.ndarray:
+    """Fail agents by schedule (cfg.faults) and by chance (cfg.fault_prob). Returns (E, A) bool."""
+    E, A = state.pos.shape
+    failed = np.zeros((E, A), dtype=bool)
+    if cfg.fault_prob > 0:
+        failed |= (state.status == ACTIVE) & (rng.random((E, A)) < cfg.fault_prob)
+    for fault_step, k in cfg.faults:
+        hit = state.t == fault_step                                        # (E,)
+        if not hit.any():
+            continue
+        alive = (state.status == ACTIVE) | (state.status == SWAPPING)
+        key = np.where(alive, rng.random((E, A)), np.inf)
+        rank = np.argsort(np.argsort(key, axis=1), axis=1)                 # 0 = chosen first
+        failed |= hit[:, None] & alive & (rank < k)
+    state.status = np.where(failed, FAILED, state.status).astype(np.int8)
+    state.swap_left = np.where(failed, 0, state.swap_left)
+    return failed

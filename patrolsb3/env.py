@@ -1,0 +1,272 @@
+"""PettingZoo ``ParallelEnv`` over the batched core: the one-episode view (n_envs = 1)."""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+from gymnasium import spaces
+from pettingzoo import ParallelEnv
+from pettingzoo.utils.conversions import parallel_to_aec
+
+from .core.config import ENV_VERSION, EnvConfig, make_config
+from .core.maps import STAY, load_map
+from .core.masks import action_mask
+from .core.observe import VECTOR_SIZE, actor_observation, critic_state
+from .core.state import STATUS_NAMES, reset_state
+from .core.step import step as core_step
+
+MESSAGE_PHASE, MOVE_PHASE = 0, 1
+
+
+class PatrolParallelEnv(ParallelEnv):
+    """Multi-drone patrolling of a grid map (the paper's model, SPEC.md sections 1-5).
+
+    Agents: ``drone_0 .. drone_{max_agents-1}``; all slots stay in ``agents`` for the whole
+    episode. Slots beyond ``n_agents``, swapping or failed are *inactive*: their only legal
+    action is (0, Stay), their reward is 0 and their observation says inactive.
+
+    Observation (``Dict``), per agent:
+        * ``grid``: Box(-1, 1, (2, H, W), float32): channel 0 positions and messages, channel 1
+          normalised idleness (see :mod:`patrolsb3.core.observe`).
+        * ``vector``: Box(-1, 1, (8,), float32): battery fraction, own move mask (5), phase
+          (0 message, 1 move), active flag.
+        * ``critic``: Box(0, 1, (3 * max_agents,), float32): every slot's battery fraction and
+          position (centralised critic state; a policy's actor must not read it).
+
+    Action: ``MultiDiscrete([n_symbols, 5])`` = (message, move); message index m means symbol
+    m + 1; moves are Up, Down, Left, Right, Stay. ``info[agent]["action_mask"]`` is a tuple of
+    two int8 arrays (16,) and (5,), PettingZoo's convention for MultiDiscrete.
+
+    Phases: with ``comm='learned'`` or ``'intention'`` and ``message_timing='same_step'``
+    every simulator step takes two env steps: a message phase (the move must be Stay; the
+    reward is 0) and a move phase (the message must be index 0; the simulator steps and the
+    rewards come). In the intention mode the message index is the intended move (symbol =
+    move + 1). With ``comm='none'`` or ``'delayed'`` timing each env step is one simulator
+    step; delayed messages are shown at the next step.
+
+    Reward: the paper's R = R_p + R_b + R_c (:mod:`patrolsb3.core.reward`).
+    Termination: every deployed agent has failed. Truncation: ``episode_steps`` simulator
+    steps.
+    """
+
+    metadata = {"name": ENV_VERSION, "render_modes": ["rgb_array", "human"], "render_fps": 10,
+                "is_parallelizable": True}
+
+    def __init__(self, map="A", n_agents: int = 3, seed=None, render_mode=None,
+                 config: EnvConfig | None = None, **config_overrides):
+        """Build the env.
+
+        Args:
+            map: shipped map name ("A" .. "D"), a path to a map file, or a MapSpec.
+            n_agents: agents deployed at each reset (1 .. max_agents); ``reset(options=
+                {"n_agents": k})`` changes it.
+            seed: seed of the first reset when ``reset`` gets none.
+            render_mode: None, "rgb_array" or "human" (a matplotlib window).
+            config: a full EnvConfig; otherwise one is built from the map's paper values and
+                ``config_overrides`` (any EnvConfig field).
+        """
+        self.spec_map = load_map(map)
+        self.cfg = config if config is not None else make_config(self.spec_map.name, **config_overrides)
+        if config is not None and config_overrides:
+            raise TypeError("give either config= or keyword overrides, not both")
+        self._check_team(n_agents)
+        self.n_agents = int(n_agents)
+        self.render_mode = render_mode
+        if render_mode not in (None, "rgb_array", "human"):
+            raise ValueError(f"render_mode must be None, 'rgb_array' or 'human', got {render_mode!r}")
+        self.possible_agents = [f"drone_{i}" for i in range(self.cfg.max_agents)]
+        self.agents = []
+        self._seed = seed
+        self.core_state = None
+        self.phase = MOVE_PHASE
+        self._two_phase = self.cfg.comm != "none" and self.cfg.message_timing == "same_step"
+        H, W = self.spec_map.shape
+        A = self.cfg.max_agents
+        self._obs_space = spaces.Dict({
+            "grid": spaces.Box(-1.0, 1.0, (2, H, W), np.float32),
+            "vector": spaces.Box(-1.0, 1.0, (VECTOR_SIZE,), np.float32),
+            "critic": spaces.Box(0.0, 1.0, (3 * A,), np.float32),
+        })
+        self._act_space = spaces.MultiDiscrete([self.cfg.n_symbols, 5])
+        self._viewer = None
+
+    def _check_team(self, n_agents):
+        if not 1 <= int(n_agents) <= self.cfg.max_agents:
+            raise ValueError(f"n_agents={n_agents} must be between 1 and max_agents={self.cfg.max_agents}")
+        if int(n_agents) > self.spec_map.n_vertices:
+            raise ValueError(f"n_agents={n_agents} is larger than the {self.spec_map.n_vertices} "
+                             f"vertices of map {self.spec_map.name}")
+
+    @functools.lru_cache(maxsize=None)
+    def observation_space(self, agent):
+        return self._obs_space
+
+    @functools.lru_cache(maxsize=None)
+    def action_space(self, agent):
+        return self._act_space
+
+    # ------------------------------------------------------------------ API
+    def reset(self, seed=None, options=None):
+        """Start an episode. ``options={"n_agents": k}`` changes the team size."""
+        if seed is None and self._seed is not None:
+            seed, self._seed = self._seed, None
+        if options and "n_agents" in options:
+            self._check_team(options["n_agents"])
+            self.n_agents = int(options["n_agents"])
+        self.core_state = reset_state(self.spec_map, self.cfg, self.n_agents, n_envs=1, seed=seed)
+        self.agents = list(self.possible_agents)
+        self.phase = MESSAGE_PHASE if self._two_phase else MOVE_PHASE
+        self._last_info = None
+        self.episode_collisions = 0
+        return self._observations(), self._infos(None)
+
+    def step(self, actions):
+        """Apply one (message, move) action per agent; see the class docstring for phases."""
+        A = self.cfg.max_agents
+        act = np.zeros((A, 2), dtype=np.int64)
+        act[:, 1] = STAY
+        for i, name in enumerate(self.possible_agents):
+            if name in actions and actions[name] is not None:
+                act[i] = np.asarray(actions[name], dtype=np.int64).reshape(2)
+        active = self.core_state.active[0]
+        comm = self.cfg.comm
+        if self.phase == MESSAGE_PHASE:
+            self._check_message_phase(act, active)
+            symbols = self._symbols(act[:, 0], active)
+            self.core_state.messages = symbols[None]
+            self.phase = MOVE_PHASE
+            zeros = {a: 0.0 for a in self.agents}
+            falses = {a: False for a in self.agents}
+            return self._observations(), zeros, falses, dict(falses), self._infos(None)
+        if self._two_phase or comm == "none":
+            bad = active & (act[:, 0] != 0)
+            act[:, 0] = 0
+            if bad.any() and self.cfg.invalid_action == "raise":
+                raise ValueError(f"{self.possible_agents[int(np.argmax(bad))]} sent message index "
+                                 f"{act[int(np.argmax(bad)), 0]} where only 0 is legal (its mask "
+                                 f"allows no message in this phase)")
+            info = core_step(self.spec_map, self.cfg, self.core_state, act[None, :, 1])
+        else:  # delayed messages: chosen now, shown at the next step
+            symbols = self._symbols(act[:, 0], active)
+            info = core_step(self.spec_map, self.cfg, self.core_state, act[None, :, 1],
+                             messages=np.zeros((1, A), dtype=np.int64))
+            self.core_state.messages = np.where(self.core_state.active, symbols[None], 0)
+        if self._two_phase:
+            self.phase = MESSAGE_PHASE
+            self.core_state.messages = np.zeros_like(self.core_state.messages)
+        self.episode_collisions += int(info.collisions[0])
+        self._last_info = info
+        rewards = {a: float(info.reward[0, i]) for i, a in enumerate(self.agents)}
+        term = bool(info.terminated[0])
+        trunc = bool(info.truncated[0]) and not term
+        terminations = {a: term for a in self.agents}
+        truncations = {a: trunc for a in self.agents}
+        obs, infos = self._observations(), self._infos(info)
+        if term or trunc:
+            self.agents = []
+        return obs, rewards, terminations, truncations, infos
+
+    def _symbols(self, message_idx, active):
+        """Symbols (1..n_symbols) shown by active slots, 0 for the others."""
+        return np.where(active, message_idx + 1, 0).astype(np.int64)
+
+    def _check_message_phase(self, act, active):
+        """Check (or, with invalid_action='stay', repair in place) message-phase actions."""
+        masks = self._masks()
+        for i, name in enumerate(self.possible_agents):
+            m_ok = 0 <= act[i, 0] < self.cfg.n_symbols and masks[i][0][act[i, 0]]
+            if m_ok and act[i, 1] == STAY:
+                continue
+            if self.cfg.invalid_action == "raise":
+                raise ValueError(f"{name}: action {tuple(int(v) for v in act[i])} is not legal in the "
+                                 f"message phase (message must be allowed by its mask, move must be Stay)")
+            act[i, 1] = STAY
+            if not m_ok:
+                act[i, 0] = int(np.argmax(masks[i][0]))
+
+    def _masks(self):
+        """Per slot (message_mask (n_symbols,), move_mask (5,)) int8, for the current phase."""
+        move = action_mask(self.spec_map, self.core_state)[0]                    # (A, 5)
+        active = self.core_state.active[0]
+        out = []
+        for i in range(self.cfg.max_agents):
+            msg = np.zeros(self.cfg.n_symbols, dtype=np.int8)
+            mv = move[i].astype(np.int8)
+            if self.phase == MESSAGE_PHASE or (not self._two_phase and self.cfg.comm != "none"):
+                if not active[i]:
+                    msg[0] = 1
+                elif self.cfg.comm == "intention":
+                    msg[:5] = move[i]
+                else:
+                    msg[:] = 1
+                if self.phase == MESSAGE_PHASE:
+                    mv = np.zeros(5, dtype=np.int8)
+                    mv[STAY] = 1
+            else:
+                msg[0] = 1
+            out.append((msg, mv))
+        return out
+
+    def _observations(self):
+        grid, vector = actor_observation(self.spec_map, self.cfg, self.core_state, phase=self.phase)
+        critic = critic_state(self.spec_map, self.cfg, self.core_state)[0]
+        return {name: {"grid": grid[0, i], "vector": vector[0, i], "critic": critic}
+                for i, name in enumerate(self.possible_agents)}
+
+    def _infos(self, info):
+        masks = self._masks()
+        s = self.core_state
+        out = {}
+        for i, name in enumerate(self.possible_agents):
+            d = {
+                "action_mask": masks[i],
+                "phase": "message" if self.phase == MESSAGE_PHASE else "move",
+                "status": STATUS_NAMES[s.status[0, i]],
+                "battery": float(s.battery[0, i] / self.cfg.b_max),
+                "step": int(s.t[0]),
+            }
+            if info is not None:
+                d.update({
+                    "collided": bool(info.collided[0, i]),
+                    "collisions": int(info.collisions[0]),
+                    "pushed": bool(info.pushed[0, i]),
+                    "swap_started": bool(info.swap_started[0, i]),
+                    "swap_battery": float(info.swap_battery[0, i]),
+                    "battery_failed": bool(info.battery_failed[0, i]),
+                    "fault_failed": bool(info.fault_failed[0, i]),
+                    "mean_idleness": float(info.mean_idleness[0]),
+                    "max_idleness": float(info.max_idleness[0]),
+                    "team_patrol_reward": float(info.team_patrol[0]),
+                })
+            out[name] = d
+        return out
+
+    # ------------------------------------------------------------------ rendering
+    def render(self):
+        """An RGB frame (H_px, W_px, 3) uint8 in 'rgb_array' mode; a window in 'human' mode."""
+        if self.render_mode is None:
+            raise ValueError("render() needs render_mode='rgb_array' or 'human' at construction")
+        from .render import render_frame, show_frame
+        frame = render_frame(self.spec_map, self.cfg, self.core_state)
+        if self.render_mode == "human":
+            self._viewer = show_frame(frame, self._viewer)
+            return None
+        return frame
+
+    def close(self):
+        self._viewer = None
+
+    def state_array(self):
+        """The core's batched state of this episode (n_envs = 1); heuristics may read it."""
+        return self.core_state
+
+
+def parallel_env(map="A", n_agents: int = 3, seed=None, render_mode=None, **config) -> PatrolParallelEnv:
+    """The patrolling world as a PettingZoo ``ParallelEnv`` (see :class:`PatrolParallelEnv`)."""
+    return PatrolParallelEnv(map=map, n_agents=n_agents, seed=seed, render_mode=render_mode, **config)
+
+
+def env(map="A", n_agents: int = 3, seed=None, render_mode=None, **config):
+    """The AEC view of :func:`parallel_env` (PettingZoo's ``parallel_to_aec``)."""
+    return parallel_to_aec(parallel_env(map=map, n_agents=n_agents, seed=seed,
+                                        render_mode=render_mode, **config))
