@@ -1,0 +1,1 @@
+"""Speed benchmarks behind ``patrolsb3 bench``; each module has ``run(repeats, quick) -> dict``."""

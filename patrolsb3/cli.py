@@ -1,0 +1,49 @@
+"""The ``patrolsb3`` command line: ``patrolsb3 maps | render | evaluate | compare | train |
+bench | zoo``.
+
+Each sub-command lives in its own module ``patrolsb3.commands.<name>`` with two functions,
+``add_arguments(parser)`` and ``run(args) -> int``; modules import their heavy dependencies
+(torch, SB3) inside ``run`` so that ``patrolsb3 maps`` starts fast.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+COMMANDS = {
+    "maps": "list the shipped maps, draw them in the terminal or as PNG",
+    "render": "animate a run (random or heuristic) as a GIF",
+    "evaluate": "evaluate one strategy on one map with the paper's metrics",
+    "compare": "run every strategy and write the paper's tables and plots",
+    "train": "train a parameter-shared policy with SB3",
+    "bench": "measure speed: env | evaluate | train",
+    "zoo": "list or inspect the trained checkpoints in zoo/",
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser with every sub-command registered."""
+    parser = argparse.ArgumentParser(prog="patrolsb3", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for name, help_text in COMMANDS.items():
+        module = importlib.import_module(f"patrolsb3.commands.{name}")
+        p = sub.add_parser(name, help=help_text, description=help_text)
+        module.add_arguments(p)
+        p.set_defaults(_module=module)
+    return parser
+
+
+def main(argv=None) -> int:
+    """Entry point of the ``patrolsb3`` console script."""
+    from .core.maps import MapError
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args._module.run(args) or 0)
+    except (MapError, ValueError, TypeError, FileNotFoundError) as exc:
+        print(f"patrolsb3 {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

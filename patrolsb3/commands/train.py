@@ -1,0 +1,9 @@
+"""``patrolsb3 train``: not implemented yet (placeholder to be replaced by its owner)."""
+
+
+def add_arguments(parser):
+    pass
+
+
+def run(args):
+    raise NotImplementedError("patrolsb3 train is not implemented yet")
