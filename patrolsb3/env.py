@@ -10,7 +10,7 @@ from pettingzoo.utils.conversions import parallel_to_aec
 
 from .core.config import ENV_VERSION, EnvConfig, make_config
 from .core.maps import STAY, load_map
-from .core.masks import action_mask
+from .core.masks import composite_action_mask
 from .core.observe import VECTOR_SIZE, actor_observation, critic_state
 from .core.state import STATUS_NAMES, reset_state
 from .core.step import step as core_step
@@ -186,26 +186,10 @@ class PatrolParallelEnv(ParallelEnv):
 
     def _masks(self):
         """Per slot (message_mask (n_symbols,), move_mask (5,)) int8, for the current phase."""
-        move = action_mask(self.spec_map, self.core_state)[0]                    # (A, 5)
-        active = self.core_state.active[0]
-        out = []
-        for i in range(self.cfg.max_agents):
-            msg = np.zeros(self.cfg.n_symbols, dtype=np.int8)
-            mv = move[i].astype(np.int8)
-            if self.phase == MESSAGE_PHASE or (not self._two_phase and self.cfg.comm != "none"):
-                if not active[i]:
-                    msg[0] = 1
-                elif self.cfg.comm == "intention":
-                    msg[:5] = move[i]
-                else:
-                    msg[:] = 1
-                if self.phase == MESSAGE_PHASE:
-                    mv = np.zeros(5, dtype=np.int8)
-                    mv[STAY] = 1
-            else:
-                msg[0] = 1
-            out.append((msg, mv))
-        return out
+        message, move = composite_action_mask(self.spec_map, self.cfg, self.core_state,
+                                              message_phase=self.phase == MESSAGE_PHASE)
+        return [(message[0, i].astype(np.int8), move[0, i].astype(np.int8))
+                for i in range(self.cfg.max_agents)]
 
     def _observations(self):
         grid, vector = actor_observation(self.spec_map, self.cfg, self.core_state, phase=self.phase)

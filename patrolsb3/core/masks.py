@@ -33,3 +33,42 @@ def action_mask(spec: MapSpec, state: State) -> np.ndarray:
     mask[..., STAY] = True
     mask[~active] = np.array([False, False, False, False, True])
     return mask
+
+
+def composite_action_mask(spec: MapSpec, cfg, state: State, message_phase: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Masks of the composite (message, move) action for every slot, in one phase.
+
+    * Message phase (same-step messages): the move must be Stay; an active slot may send any
+      symbol (comm 'learned'), or its intended move (comm 'intention': message index = move).
+    * Move phase with same-step messages, or comm 'none': the message must be index 0; moves
+      follow :func:`action_mask`.
+    * Delayed messages (message and move chosen together): both halves free, as above.
+    * Inactive slots: only (0, Stay).
+
+    Args:
+        spec: the map.
+        cfg: environment parameters (comm, message_timing, n_symbols).
+        state: batched state.
+        message_phase: True in the message phase of a same-step exchange.
+
+    Returns:
+        message (E, A, n_symbols) bool and move (E, A, 5) bool.
+    """
+    move = action_mask(spec, state)                                        # (E, A, 5)
+    E, A = state.pos.shape
+    message = np.zeros((E, A, cfg.n_symbols), dtype=bool)
+    chooses_message = cfg.comm != "none" and (message_phase or cfg.message_timing == "delayed")
+    active = state.active
+    if chooses_message:
+        if cfg.comm == "intention":
+            message[..., :5] = move
+        else:
+            message[...] = True
+        message[~active] = False
+        message[~active, 0] = True
+    else:
+        message[..., 0] = True
+    if message_phase:
+        move = np.zeros_like(move)
+        move[..., STAY] = True
+    return message, move
