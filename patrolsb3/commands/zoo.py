@@ -1,9 +1,42 @@
-"""``patrolsb3 zoo``: not implemented yet (placeholder to be replaced by its owner)."""
+"""``patrolsb3 zoo list``: every zoo entry with its budget, date, env version and headline
+figures; ``patrolsb3 zoo show MAP VARIANT``: one entry's config and evaluation."""
+import json
 
 
 def add_arguments(parser):
-    pass
+    sub = parser.add_subparsers(dest="zoo_command", required=True, metavar="ACTION")
+    p_list = sub.add_parser("list", help="list every zoo entry")
+    p_list.add_argument("--zoo-dir", default=None, help="another zoo folder")
+    p_show = sub.add_parser("show", help="print one entry's config and evaluation")
+    p_show.add_argument("map")
+    p_show.add_argument("variant")
+    p_show.add_argument("--zoo-dir", default=None)
+
+
+def headline(entry: dict) -> str:
+    """Short text of an entry's evaluation: MAX and AVG idleness, collisions, BF rate per n."""
+    ev = entry.get("eval") or {}
+    parts = []
+    for row in ev.get("results", []):
+        parts.append(f"n={row['n_agents']}: MAX {row['max_idleness']:.0f} AVG {row['avg_idleness']:.0f} "
+                     f"col {row['collisions']:.1f} BF {row['battery_failure_rate']:.2f}")
+    return "; ".join(parts) or "not evaluated"
 
 
 def run(args):
-    raise NotImplementedError("patrolsb3 zoo is not implemented yet")
+    from ..zoo import entry_dir, list_entries, read_entry
+    if args.zoo_command == "show":
+        print(json.dumps(read_entry(entry_dir(args.map, args.variant, args.zoo_dir)), indent=2, default=str))
+        return 0
+    entries = list_entries(args.zoo_dir)
+    if not entries:
+        print("the zoo is empty")
+        return 0
+    for e in entries:
+        c = e["config"]
+        budget = c.get("budget", {})
+        print(f"{c.get('map', '?')}/{c.get('variant', '?')}  algo {c.get('algo', '?')}  "
+              f"env {c.get('env_version', '?')}  trained {c.get('date', '?')}  "
+              f"{budget.get('timesteps', '?')} steps, {budget.get('cpu_hours', '?')} CPU h")
+        print(f"    {headline(e)}")
+    return 0
