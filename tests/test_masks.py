@@ -1,0 +1,84 @@
+"""patrolsb3.core.masks: move masks on a non-square map, and the composite (message, move) masks."""
+import numpy as np
+
+from patrolsb3.core.masks import action_mask, composite_action_mask
+from patrolsb3.core.state import FAILED, SWAPPING, reset_state
+
+from conftest import cell, deterministic_config, place
+
+#                     Up     Down   Left   Right  Stay
+ONLY_STAY = [False, False, False, False, True]
+
+
+def test_masks_on_a_non_square_map(non_square_map):
+    spec = non_square_map            # "S..#..2" / ".#....." / "...#5.."
+    cfg = deterministic_config(max_agents=4)
+    state = place(spec, cfg, [(1, 4), (1, 5), (1, 0), (0, 6)])
+    mask = action_mask(spec, state)
+    assert mask.shape == (1, 4, 5) and mask.dtype == bool
+    assert list(mask[0, 0]) == [True, True, True, False, True]     # Right: (1, 5) occupied
+    assert list(mask[0, 1]) == [True, True, False, True, True]     # Left: (1, 4) occupied
+    assert list(mask[0, 2]) == [True, True, False, False, True]    # Left: border, Right: obstacle
+    assert list(mask[0, 3]) == [False, True, True, False, True]    # Up and Right: border
+
+
+def test_occupied_station_stays_enterable(non_square_map):
+    spec = non_square_map
+    cfg = deterministic_config(max_agents=3)
+    state = place(spec, cfg, [(0, 1), (1, 0), (2, 0)])
+    state.pos[0, 2] = spec.station
+    mask = action_mask(spec, state)[0]
+    assert mask[0, 2] and mask[1, 0]       # Left from (0, 1), Up from (1, 0): both into S
+    assert not mask[2, 1]                  # Down from the station: (1, 0) is occupied
+
+
+def test_inactive_agents_block_nothing_and_may_only_stay(line_map):
+    spec = line_map
+    cfg = deterministic_config(max_agents=3)
+    state = place(spec, cfg, [(0, 1), (0, 2), (0, 4)])
+    state.status[0, 1] = FAILED
+    state.status[0, 2] = SWAPPING
+    mask = action_mask(spec, state)[0]
+    assert list(mask[0]) == [False, False, True, True, True]        # into the failed agent's cell
+    assert list(mask[1]) == ONLY_STAY
+    assert list(mask[2]) == ONLY_STAY
+
+
+def test_batched_masks_follow_each_episode(line_map):
+    spec = line_map
+    cfg = deterministic_config(max_agents=2)
+    two = reset_state(spec, cfg, 2, n_envs=2, seed=0)
+    two.pos[:] = [[cell(spec, 0, 3), cell(spec, 0, 4)], [cell(spec, 0, 3), cell(spec, 0, 1)]]
+    mask = action_mask(spec, two)
+    assert list(mask[0, 0]) == [False, False, True, False, True]
+    assert list(mask[1, 0]) == [False, False, True, True, True]
+
+
+def test_composite_masks_by_phase_and_mode(line_map):
+    spec = line_map
+    state_cfg = deterministic_config(max_agents=2)
+    state = place(spec, state_cfg, [(0, 1)])                       # slot 1 absent
+    move_mask = action_mask(spec, state)
+
+    cfg = deterministic_config(max_agents=2, comm="learned")
+    message, move = composite_action_mask(spec, cfg, state, message_phase=True)
+    assert message.shape == (1, 2, 16) and move.shape == (1, 2, 5)
+    assert message[0, 0].all()
+    assert list(move[0, 0]) == ONLY_STAY
+    assert list(np.flatnonzero(message[0, 1])) == [0] and list(move[0, 1]) == ONLY_STAY
+    message, move = composite_action_mask(spec, cfg, state, message_phase=False)
+    assert list(np.flatnonzero(message[0, 0])) == [0]
+    assert np.array_equal(move, move_mask)
+
+    cfg = deterministic_config(max_agents=2, comm="intention")
+    message, move = composite_action_mask(spec, cfg, state, message_phase=True)
+    assert list(message[0, 0, :5]) == list(move_mask[0, 0]) and not message[0, 0, 5:].any()
+
+    cfg = deterministic_config(max_agents=2, comm="learned", message_timing="delayed")
+    message, move = composite_action_mask(spec, cfg, state, message_phase=False)
+    assert message[0, 0].all() and np.array_equal(move, move_mask)
+    assert list(np.flatnonzero(message[0, 1])) == [0]
+
+    cfg = deterministic_config(max_agents=2, comm="none")
+    message, move = composite_action_mask(spec, cfg, state, message_phase=False)
+    assert list(np.flatnonzero(message[0, 0])) == [0] and np.array_equal(move, move_mask)
