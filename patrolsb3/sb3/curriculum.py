@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from typing import Callable
 
+import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
 CURRICULUM = [
@@ -70,8 +71,10 @@ class CurriculumCallback(BaseCallback):
     """Sets the training env's team sizes to the curriculum stage of the run's progress.
 
     The stage is recomputed from ``model.num_timesteps`` at training start, so a resumed run
-    continues at the right stage; a change applies to each parallel episode from its next reset.
-    Logged as ``curriculum/stage``.
+    continues at the right stage. At training start, if the episodes that ``learn`` has just
+    reset do not deploy the stage's teams, the env is reset again (and the model's last
+    observation with it) so that training never starts on the wrong teams; later stage changes
+    apply to each parallel episode from its next reset. Logged as ``curriculum/stage``.
 
     Args:
         total_timesteps: timesteps of the whole run (progress = num_timesteps / total_timesteps).
@@ -100,7 +103,20 @@ class CurriculumCallback(BaseCallback):
 
     def _on_training_start(self) -> None:
         self._apply(self._stage_now())
+        env = find_set_agents(self.training_env)
+        deployed = [env.get_env(i).n_agents for i in range(env.n_episodes)]
+        if deployed != env.get_agents() and getattr(self.model, "_last_obs", None) is not None:
+            self._restart_episodes()
         self.logger.record("curriculum/stage", self.stage)
+
+    def _restart_episodes(self) -> None:
+        """Reset the training env so the stage's teams are deployed now, and hand the model
+        the new first observation (as ``learn``'s own setup does)."""
+        self.model._last_obs = self.training_env.reset()
+        self.model._last_episode_starts = np.ones((self.training_env.num_envs,), dtype=bool)
+        normalize = self.model.get_vec_normalize_env()
+        if normalize is not None:
+            self.model._last_original_obs = normalize.get_original_obs()
 
     def _on_step(self) -> bool:
         stage = self._stage_now()

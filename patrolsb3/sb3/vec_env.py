@@ -226,6 +226,16 @@ class PatrolVecEnv(VecEnvWrapper):
         self._update_masks(infos)
         return flatten_observation(obs), np.asarray(rewards, dtype=np.float32), dones, infos
 
+    def set_options(self, options=None) -> None:
+        """Reset options are not forwarded by SuperSuit; team sizes go through set_agents.
+
+        Raises:
+            NotImplementedError: any options given.
+        """
+        if options:
+            raise NotImplementedError(f"PatrolVecEnv takes no reset options ({options!r}); change "
+                                      f"team sizes with set_agents([...]) and seeds with seed(s)")
+
     def has_attr(self, attr_name: str) -> bool:
         """True for ``action_masks`` and for attributes of the PettingZoo env."""
         return attr_name == MASK_METHOD or hasattr(self.get_env(0), attr_name)
