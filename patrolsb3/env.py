@@ -140,11 +140,11 @@ class PatrolParallelEnv(ParallelEnv):
             return self._observations(), zeros, falses, dict(falses), self._infos(None)
         if self._two_phase or comm == "none":
             bad = active & (act[:, 0] != 0)
-            act[:, 0] = 0
             if bad.any() and self.cfg.invalid_action == "raise":
                 raise ValueError(f"{self.possible_agents[int(np.argmax(bad))]} sent message index "
                                  f"{act[int(np.argmax(bad)), 0]} where only 0 is legal (its mask "
                                  f"allows no message in this phase)")
+            act[:, 0] = 0
             info = core_step(self.spec_map, self.cfg, self.core_state, act[None, :, 1])
         else:  # delayed messages: chosen now, shown at the next step
             symbols = self._symbols(act[:, 0], active)
@@ -215,7 +215,9 @@ class PatrolParallelEnv(ParallelEnv):
                     "collisions": int(info.collisions[0]),
                     "pushed": bool(info.pushed[0, i]),
                     "swap_started": bool(info.swap_started[0, i]),
-                    "swap_battery": float(info.swap_battery[0, i]),
+                    # None (not nan) when no swap started: nan != nan breaks seed checks
+                    "swap_battery": (float(info.swap_battery[0, i]) if info.swap_started[0, i]
+                                     else None),
                     "battery_failed": bool(info.battery_failed[0, i]),
                     "fault_failed": bool(info.fault_failed[0, i]),
                     "mean_idleness": float(info.mean_idleness[0]),
