@@ -6,7 +6,7 @@ import pytest
 import torch
 from sb3_contrib import MaskablePPO
 from sb3_contrib.common.maskable.utils import get_action_masks, is_masking_supported
-from stable_baselines3.common.vec_env import VecMonitor
+from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
 from patrolsb3.core import parse_map
 from patrolsb3.core.maps import STAY
@@ -101,10 +101,12 @@ def test_rows_mirror_independent_envs(spec):
         assert not dones.any()
 
 
-@pytest.mark.parametrize("variant", sorted(VARIANTS))
-def test_strict_env_accepts_masked_random_actions_and_pads_slots(spec, variant):
+@pytest.mark.parametrize("variant,timing", [(v, "same_step") for v in sorted(VARIANTS)]
+                         + [("rl-msg", "delayed")])
+def test_strict_env_accepts_masked_random_actions_and_pads_slots(spec, variant, timing):
     """A few hundred steps of mask-sampled actions never raise; padded slots only (0, Stay), reward 0."""
-    venv = make_vec_env(spec, agents=[1, 3, 5], variant=variant, seed=2, episode_steps=30, strict=True)
+    venv = make_vec_env(spec, agents=[1, 3, 5], variant=variant, seed=2, episode_steps=30,
+                        strict=True, message_timing=timing)
     venv.reset()
     rng = np.random.default_rng(1)
     only_noop = np.zeros(21, dtype=bool)
@@ -257,9 +259,9 @@ def test_sb3_contrib_mask_helpers_and_wrappers(spec):
     assert is_masking_supported(venv)
     assert venv.has_attr("action_masks")
     np.testing.assert_array_equal(get_action_masks(venv), venv.action_masks())
-    monitored = VecMonitor(venv)
-    assert is_masking_supported(monitored)
-    np.testing.assert_array_equal(get_action_masks(monitored), venv.action_masks())
+    for wrapped in (VecMonitor(venv), VecNormalize(VecMonitor(venv))):
+        assert is_masking_supported(wrapped)
+        np.testing.assert_array_equal(get_action_masks(wrapped), venv.action_masks())
     assert venv.env_method("action_masks", indices=[3])[0].shape == (21,)
     assert venv.env_is_wrapped(object) == [False] * venv.num_envs
 

@@ -110,6 +110,13 @@ class PatrolVecEnv(VecEnvWrapper):
     Infos at an episode's last step (every row of it): ``terminal_observation`` (flat),
     ``TimeLimit.truncated`` (cut by the horizon, not terminated), ``episode`` ({"r": the
     slot's return, "l": env steps}) and ``team_episode`` (see :meth:`_team_summary`).
+
+    Attributes:
+        layout: {"grid_shape": (2, H, W), "vector_size": 8, "critic_size": 3 * max_agents}.
+        phases_per_step: env steps per simulator step (2 with same-step messages, else 1);
+            discount per env step = gamma ** (1 / phases_per_step), gamma per simulator step.
+        max_agents: slots per parallel episode.
+        n_episodes: parallel episodes (``num_envs // max_agents``).
     """
 
     def __init__(self, venv):
