@@ -273,3 +273,11 @@ def test_maskable_ppo_learns_without_error(spec):
     model.learn(256)
     assert model.num_timesteps >= 256
     assert len(model.ep_info_buffer) > 0
+
+
+def test_package_exports_lazily():
+    import patrolsb3.sb3 as sb3
+    assert sb3.make_vec_env is make_vec_env
+    assert sb3.MaskableRecurrentPPO.__name__ == "MaskableRecurrentPPO"
+    with pytest.raises(AttributeError, match="no_such_name"):
+        sb3.no_such_name

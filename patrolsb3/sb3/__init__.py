@@ -11,6 +11,8 @@ __all__ = ["CURRICULUM", "CurriculumCallback", "PatrolVecEnv", "VARIANTS", "curr
 # imports even while those modules are being written (and stays cheap to import).
 _LAZY = {
     "MaskableRecurrentPPO": "maskable_recurrent_ppo",
+    "ALGORITHMS": "algorithms",
+    "evaluate": "evaluation",
     "train": "train",
 }
 
