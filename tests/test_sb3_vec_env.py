@@ -138,6 +138,16 @@ def test_strict_raises_on_masked_move_and_lenient_stays(spec):
     lenient.step(actions)  # masked move acts as Stay
 
 
+@pytest.mark.parametrize("variant", sorted(VARIANTS))
+def test_lenient_env_accepts_any_action(spec, variant):
+    """strict=False (algorithms without masks): unmasked random actions never raise."""
+    venv = make_vec_env(spec, agents=[1, 5], variant=variant, seed=0, episode_steps=10, strict=False)
+    venv.reset()
+    rng = np.random.default_rng(0)
+    for _ in range(60):
+        venv.step(np.stack([rng.integers(0, 16, venv.num_envs), rng.integers(0, 5, venv.num_envs)], 1))
+
+
 @pytest.mark.parametrize("variant,env_steps", [("rl-msg", 10), ("rl-no-msg", 5)])
 def test_horizon_marks_truncation_and_keeps_terminal_observation(spec, variant, env_steps):
     venv = make_vec_env(spec, agents=[2, 1], variant=variant, seed=4, episode_steps=5)
