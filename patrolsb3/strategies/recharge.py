@@ -1,0 +1,99 @@
+"""The recharge planner every heuristic shares (SPEC.md section 6).
+
+Rule: an active agent heads for its nearest charging station as soon as
+
+    battery <= steps_home(cell) * drain_high * push_factor_margin + b_l
+
+where ``steps_home`` is the shortest-path length to the nearest station, ``drain_high`` the
+largest drain of one step (``cfg.drain[1]``) and
+
+    push_factor_margin = (1 + p_dyn_max (push_drain_factor - 1))   # pushed steps drain more
+                         * (1 + 2 p_dyn_max)                         # a push costs ~2 steps
+                         * WAIT_ALLOWANCE                            # waiting / yielding
+
+so that it arrives with about ``b_l`` (20 % of b_max) to spare. The decision is latched: the
+agent keeps heading home (shortest path, valid moves only) until its swap starts, and a new
+agent appears with a full battery. An agent that the wind pushed onto the station (a pushed
+arrival starts no swap) steps off and back on.
+
+Deadlocks: any number of agents may share a station, so arrivals never wait for each other
+there; agents leave a station only while no agent heading home is within
+``STATION_CLEARANCE`` steps of it (the station exit rule: dead-end corridors to the station
+stay one-way). In corridors a returning agent has priority: patrolling agents move aside after
+``PATROL_PATIENCE`` blocked steps, a returning agent only after ``HOME_PATIENCE``
+(see :meth:`patrolsb3.strategies.navigation.Navigator.unblock`).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.config import EnvConfig
+from ..core.maps import MapSpec
+from ..core.masks import station_cells
+from ..core.state import ACTIVE, State
+from .navigation import Navigator
+
+WAIT_ALLOWANCE = 1.25
+"""Extra factor on the trip home for steps spent waiting or yielding in traffic."""
+PATROL_PATIENCE = 3
+"""Blocked steps a patrolling agent tolerates before moving aside."""
+HOME_PATIENCE = 8
+"""Blocked steps an agent heading home tolerates before moving aside (it has priority)."""
+STATION_CLEARANCE = 6
+"""Station exit rule: an agent on a station stays while an agent heading home is this close."""
+
+
+class RechargePlanner:
+    """Decides who heads home and how.
+
+    Args:
+        spec: the map.
+        cfg: environment parameters (battery, drain, pushes).
+    """
+
+    def __init__(self, spec: MapSpec, cfg: EnvConfig):
+        self.spec = spec
+        station_free = spec.free_index[spec.stations]                          # (S,)
+        to_station = spec.dist[:, station_free]                                 # (F, S)
+        n_cells = spec.kinds.size
+        self.station_of_cell = np.full(n_cells, spec.station, dtype=np.int64)   # (H*W,) nearest station
+        self.station_of_cell[spec.free_cells] = spec.stations[np.argmin(to_station, axis=1)]
+        self.steps_home = np.zeros(n_cells)                                     # (H*W,)
+        self.steps_home[spec.free_cells] = to_station.min(axis=1)
+        self.push_factor_margin = ((1 + cfg.p_dyn_max * (cfg.push_drain_factor - 1))
+                                   * (1 + 2 * cfg.p_dyn_max) * WAIT_ALLOWANCE)
+        self.threshold = (self.steps_home * cfg.drain[1] * self.push_factor_margin
+                          + cfg.b_low)                                          # (H*W,) battery units
+        self.is_station = station_cells(spec)                                   # (H*W,)
+
+    def update(self, sim: State, returning: np.ndarray) -> np.ndarray:
+        """Latch the "heading home" flag in place and return it.
+
+        Args:
+            sim: the batched simulator state.
+            returning: (E, A) bool flags carried between steps, updated in place.
+
+        Returns:
+            The same (E, A) array: active agents heading for a station.
+        """
+        active = sim.status == ACTIVE
+        returning |= active & (sim.battery <= self.threshold[sim.pos])
+        returning &= active
+        return returning
+
+    def home_traffic(self, sim: State, returning: np.ndarray) -> np.ndarray:
+        """(E,) bool: an agent heading home is within ``STATION_CLEARANCE`` steps of a station."""
+        return (returning & (self.steps_home[sim.pos] <= STATION_CLEARANCE)).any(axis=1)
+
+    def moves(self, nav: Navigator, sim: State, mask: np.ndarray):
+        """Moves toward the nearest station for every slot (meaningful where heading home).
+
+        Returns:
+            moves (E, A) int64 and stuck (E, A) bool.
+        """
+        pos = sim.pos
+        moves, stuck = nav.toward(pos, self.station_of_cell[pos], mask)
+        on_station = self.is_station[pos]
+        if on_station.any():   # pushed onto the station: step off to come back on purpose
+            moves = np.where(on_station, nav.random_moves(pos, mask, include_stay=False), moves)
+        return moves, stuck
