@@ -40,6 +40,7 @@ STATION_RGB = (70, 130, 200)
 GRID_LINE_RGB = (200, 200, 200)
 TEXT_RGB = (20, 20, 20)
 FOOTER_RGB = (255, 255, 255)
+PRIORITY_RGB = (150, 90, 200)     # tint of priority vertices in map pictures
 BATTERY_OK_RGB = (40, 170, 60)
 BATTERY_LOW_RGB = (220, 40, 40)
 AGENT_RGB = [(31, 119, 180), (255, 127, 14), (44, 160, 44), (148, 103, 189), (227, 119, 194),
@@ -266,8 +267,19 @@ def draw_map_png(spec: MapSpec, path, tile: int = TILE) -> Path:
     from matplotlib.patches import Patch
 
     H, W = spec.shape
+    image = _static_layers(spec, tile)[0].copy()                 # no ink: labels come below
+    tint = np.kron(spec.priority, np.ones((tile, tile), dtype=np.int8))            # (H*t, W*t)
+    tinted = (tint > 0) & (image == EMPTY_RGB).all(axis=-1)
+    strength = (0.25 + 0.05 * tint[tinted])[:, None]
+    image[tinted] = ((1 - strength) * np.array(EMPTY_RGB) + strength * np.array(PRIORITY_RGB)).astype(np.uint8)
     fig, ax = plt.subplots(figsize=(1.6 + W * 0.38, 0.9 + H * 0.38), dpi=100)
-    ax.imshow(map_image(spec, tile), interpolation="nearest")
+    ax.imshow(image, interpolation="nearest", extent=(-0.5, W - 0.5, H - 0.5, -0.5))
+    for r, c in zip(*np.nonzero(spec.priority)):
+        ax.text(c, r, str(int(spec.priority[r, c])), ha="center", va="center", fontsize=10,
+                fontweight="bold", color=np.array(TEXT_RGB) / 255)
+    for cell in spec.stations:
+        r, c = divmod(int(cell), W)
+        ax.text(c, r, "S", ha="center", va="center", fontsize=10, fontweight="bold", color="white")
     ax.set_xticks([]), ax.set_yticks([])
     n_priority = int((spec.priority > 0).sum())
     ax.set_title(f"Map {spec.name}: {H} x {W}, {spec.n_vertices} vertices, "
@@ -275,7 +287,8 @@ def draw_map_png(spec: MapSpec, path, tile: int = TILE) -> Path:
     handles = [Patch(facecolor=np.array(OBSTACLE_RGB) / 255, label="obstacle"),
                Patch(facecolor=np.array(EMPTY_RGB) / 255, edgecolor="grey", label="vertex"),
                Patch(facecolor=np.array(STATION_RGB) / 255, label="S station"),
-               Patch(facecolor="white", edgecolor="grey", label="1-9 priority (rate 1+p)")]
+               Patch(facecolor=np.array(PRIORITY_RGB) / 255, alpha=0.5,
+                     label="1-9 priority p (idleness rate 1+p)")]
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
               frameon=False)
     path = Path(path)
