@@ -119,3 +119,19 @@ def test_map_picture_and_heat_map_files(non_square_map, tmp_path):
         assert img.format == "PNG"
     with pytest.raises(ValueError, match=r"one value per vertex, shape \(17,\)"):
         plot_idleness_heatmap(spec, values[:-1], tmp_path / "bad.png")
+
+
+def test_human_mode_reuses_one_window(monkeypatch):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    monkeypatch.setattr(plt, "pause", lambda interval: None)
+    env = patrolsb3.parallel_env("A", n_agents=1, seed=0, render_mode="human")
+    env.reset()
+    assert env.render() is None
+    fig, image = env._viewer
+    env.step({"drone_0": (0, 4)})
+    env.render()
+    assert env._viewer[0] is fig
+    assert np.array_equal(image.get_array(), render_frame(env.spec_map, env.cfg, env.core_state))
+    plt.close(fig)
