@@ -1,9 +1,36 @@
-"""``patrolsb3 train``: not implemented yet (placeholder to be replaced by its owner)."""
+"""``patrolsb3 train``: train a parameter-shared policy with SB3 and write its run folder."""
 
 
 def add_arguments(parser):
-    pass
+    parser.add_argument("--map", default="A", help="map name (A..D) or map file (default A)")
+    parser.add_argument("--variant", default="rl-msg", help="rl-msg | rl-no-msg | rl-intention (default rl-msg)")
+    parser.add_argument("--timesteps", type=int, default=None,
+                        help="total agent-steps (rows x env steps); default from the hyperparameters")
+    parser.add_argument("--out", default="runs/", help="root of run folders (default runs/)")
+    parser.add_argument("--algo", default=None,
+                        help="MaskableRecurrentPPO (default) | MaskablePPO | RecurrentPPO")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--run-id", default=None, help="run folder name (default <algo>_seed<seed>)")
+    parser.add_argument("--resume", action="store_true", help="continue the run folder from its newest checkpoint")
+    parser.add_argument("--hyperparams", default=None, help="YAML keyed by map with a default: entry")
+    parser.add_argument("--set", nargs="+", action="extend", default=[], metavar="KEY=VALUE",
+                        help="override hyperparameters, e.g. n_steps=128 policy_kwargs.lstm_hidden_size=64 "
+                             "env.episode_steps=1000")
+    parser.add_argument("--eval-freq", type=int, default=None, help="agent-steps between evaluations (0: none)")
+    parser.add_argument("--checkpoint-freq", type=int, default=None, help="agent-steps between checkpoints")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--verbose", type=int, default=0)
 
 
 def run(args):
-    raise NotImplementedError("patrolsb3 train is not implemented yet")
+    import sys
+
+    from ..sb3.hyperparams import parse_set
+    from ..sb3.train import train
+    run_dir = train(map=args.map, variant=args.variant, timesteps=args.timesteps, out=args.out, algo=args.algo,
+                    seed=args.seed, resume=args.resume, hyperparams=parse_set(args.set),
+                    hyperparams_file=args.hyperparams, eval_freq=args.eval_freq,
+                    checkpoint_freq=args.checkpoint_freq, progress_bar=not args.no_progress,
+                    verbose=args.verbose, run_id=args.run_id, command="patrolsb3 " + " ".join(sys.argv[1:]))
+    print(f"run folder: {run_dir}")
+    return 0

@@ -1,0 +1,190 @@
+"""MaskableRecurrentPPO: sb3-contrib's RecurrentPPO with MaskablePPO's action masks.
+
+sb3-contrib has recurrent PPO and maskable PPO but not both at once. This class keeps
+RecurrentPPO's recurrence (padded sequences, LSTM states, episode starts) and adds what
+MaskablePPO does: masks are read from the env before every step of a rollout, stored in the
+buffer (:class:`MaskableRecurrentRolloutBuffer`), and applied when actions are sampled, when
+the log-probs are recomputed in ``train`` and in ``predict``. With masks, an action a
+strict env would refuse is never sampled, and a slot with a single legal action has
+log-prob exactly 0 (no gradient through the policy loss).
+"""
+from __future__ import annotations
+
+from copy import deepcopy
+from typing import ClassVar
+
+import numpy as np
+import torch as th
+from sb3_contrib import RecurrentPPO
+from sb3_contrib.common.maskable.utils import get_action_masks, is_masking_supported
+from stable_baselines3.common.utils import explained_variance, obs_as_tensor
+from stable_baselines3.common.vec_env import VecEnv
+
+from .buffers import MaskableRecurrentRolloutBuffer
+from .policy import PatrolRecurrentPolicy
+
+
+def env_action_masks(env: VecEnv) -> np.ndarray:
+    """(num_envs, sum(nvec)) bool masks: the vec env's own ``action_masks()`` when it has
+    one (one call), else sb3-contrib's ``env_method("action_masks")`` per env."""
+    method = getattr(env, "action_masks", None)
+    if callable(method):
+        return np.asarray(method(), dtype=bool)
+    return np.asarray(get_action_masks(env), dtype=bool)
+
+
+class MaskableRecurrentPPO(RecurrentPPO):
+    """Recurrent PPO (LSTM) with invalid-action masking.
+
+    Same arguments as :class:`sb3_contrib.RecurrentPPO`; the policy must accept
+    ``action_masks`` in ``forward``, ``evaluate_actions`` and ``predict`` (the default is
+    :class:`~patrolsb3.sb3.policy.PatrolRecurrentPolicy`). The env must expose
+    ``action_masks()`` (our vec env does) or answer ``env_method("action_masks")``.
+    """
+
+    policy_aliases: ClassVar[dict] = {"PatrolRecurrentPolicy": PatrolRecurrentPolicy}
+
+    def _setup_model(self) -> None:
+        super()._setup_model()
+        lstm = self.policy.lstm_actor
+        self.rollout_buffer = MaskableRecurrentRolloutBuffer(
+            self.n_steps, self.observation_space, self.action_space,
+            (self.n_steps, lstm.num_layers, self.n_envs, lstm.hidden_size), self.device,
+            gamma=self.gamma, gae_lambda=self.gae_lambda, n_envs=self.n_envs)
+
+    def collect_rollouts(self, env: VecEnv, callback, rollout_buffer, n_rollout_steps: int) -> bool:
+        """RecurrentPPO.collect_rollouts with masks read before each step and stored; the
+        horizon bootstrap of all truncated rows is one batched critic call."""
+        assert self._last_obs is not None, "No previous observation was provided"
+        if not is_masking_supported(env) and not callable(getattr(env, "action_masks", None)):
+            raise ValueError("MaskableRecurrentPPO needs an env with action_masks() (patrolsb3.sb3.make_vec_env "
+                             "provides it); use RecurrentPPO for an env without masks")
+        self.policy.set_training_mode(False)
+        n_steps = 0
+        rollout_buffer.reset()
+        callback.on_rollout_start()
+        lstm_states = deepcopy(self._last_lstm_states)
+        dones = self._last_episode_starts
+        new_obs = self._last_obs
+        while n_steps < n_rollout_steps:
+            action_masks = env_action_masks(env)                                   # (n_envs, 21)
+            with th.no_grad():
+                obs_tensor = obs_as_tensor(self._last_obs, self.device)
+                episode_starts = th.tensor(self._last_episode_starts, dtype=th.float32, device=self.device)
+                actions, values, log_probs, lstm_states = self.policy(
+                    obs_tensor, lstm_states, episode_starts, action_masks=th.as_tensor(action_masks))
+            actions = actions.cpu().numpy()
+            new_obs, rewards, dones, infos = env.step(actions)
+            self.num_timesteps += env.num_envs
+            callback.update_locals(locals())
+            if not callback.on_step():
+                return False
+            self._update_info_buffer(infos, dones)
+            n_steps += 1
+            self._bootstrap_truncated(rewards, dones, infos, lstm_states)
+            rollout_buffer.add(self._last_obs, actions, rewards, self._last_episode_starts, values, log_probs,
+                               lstm_states=self._last_lstm_states, action_masks=action_masks)
+            self._last_obs = new_obs
+            self._last_episode_starts = dones
+            self._last_lstm_states = lstm_states
+        with th.no_grad():
+            episode_starts = th.tensor(dones, dtype=th.float32, device=self.device)
+            values = self.policy.predict_values(obs_as_tensor(new_obs, self.device), lstm_states.vf, episode_starts)
+        rollout_buffer.compute_returns_and_advantage(last_values=values, dones=dones)
+        callback.on_rollout_end()
+        return True
+
+    def _bootstrap_truncated(self, rewards: np.ndarray, dones: np.ndarray, infos: list, lstm_states) -> None:
+        """Add gamma * V(terminal observation) to the rewards (n_envs,) of rows cut by the
+        time limit (SB3 issue #633), in one batched critic call."""
+        rows = [i for i, done in enumerate(dones) if done and infos[i].get("terminal_observation") is not None
+                and infos[i].get("TimeLimit.truncated", False)]
+        if not rows:
+            return
+        terminal_obs = np.stack([infos[i]["terminal_observation"] for i in rows])     # (k, obs_dim)
+        with th.no_grad():
+            state = (lstm_states.vf[0][:, rows, :].contiguous(), lstm_states.vf[1][:, rows, :].contiguous())
+            starts = th.zeros(len(rows), dtype=th.float32, device=self.device)
+            values = self.policy.predict_values(obs_as_tensor(terminal_obs, self.device), state, starts)
+        rewards[rows] += self.gamma * values.flatten().cpu().numpy()
+
+    def train(self) -> None:
+        """RecurrentPPO.train with the stored masks applied when log-probs are recomputed."""
+        self.policy.set_training_mode(True)
+        self._update_learning_rate(self.policy.optimizer)
+        clip_range = self.clip_range(self._current_progress_remaining)
+        clip_range_vf = self.clip_range_vf(self._current_progress_remaining) if self.clip_range_vf is not None else None
+        entropy_losses, pg_losses, value_losses, clip_fractions, approx_kl_divs = [], [], [], [], []
+        continue_training = True
+        for epoch in range(self.n_epochs):
+            approx_kl_divs = []
+            for data in self.rollout_buffer.get(self.batch_size):
+                mask = data.mask > 1e-8                                            # real (not padded) steps
+                values, log_prob, entropy = self.policy.evaluate_actions(
+                    data.observations, data.actions, data.lstm_states, data.episode_starts,
+                    action_masks=data.action_masks)
+                values = values.flatten()
+                advantages = data.advantages
+                if self.normalize_advantage:
+                    advantages = (advantages - advantages[mask].mean()) / (advantages[mask].std() + 1e-8)
+                ratio = th.exp(log_prob - data.old_log_prob)
+                policy_loss_1 = advantages * ratio
+                policy_loss_2 = advantages * th.clamp(ratio, 1 - clip_range, 1 + clip_range)
+                policy_loss = -th.mean(th.min(policy_loss_1, policy_loss_2)[mask])
+                pg_losses.append(policy_loss.item())
+                clip_fractions.append(th.mean((th.abs(ratio - 1) > clip_range).float()[mask]).item())
+                if clip_range_vf is None:
+                    values_pred = values
+                else:
+                    values_pred = data.old_values + th.clamp(values - data.old_values, -clip_range_vf, clip_range_vf)
+                value_loss = th.mean(((data.returns - values_pred) ** 2)[mask])
+                value_losses.append(value_loss.item())
+                entropy_loss = -th.mean(entropy[mask])
+                entropy_losses.append(entropy_loss.item())
+                loss = policy_loss + self.ent_coef * entropy_loss + self.vf_coef * value_loss
+                with th.no_grad():
+                    log_ratio = log_prob - data.old_log_prob
+                    approx_kl_div = th.mean(((th.exp(log_ratio) - 1) - log_ratio)[mask]).cpu().numpy()
+                    approx_kl_divs.append(approx_kl_div)
+                if self.target_kl is not None and approx_kl_div > 1.5 * self.target_kl:
+                    continue_training = False
+                    if self.verbose >= 1:
+                        print(f"Early stopping at step {epoch} due to reaching max kl: {approx_kl_div:.2f}")
+                    break
+                self.policy.optimizer.zero_grad()
+                loss.backward()
+                th.nn.utils.clip_grad_norm_(self.policy.parameters(), self.max_grad_norm)
+                self.policy.optimizer.step()
+            self._n_updates += 1
+            if not continue_training:
+                break
+        explained_var = explained_variance(self.rollout_buffer.values.flatten(), self.rollout_buffer.returns.flatten())
+        self.logger.record("train/entropy_loss", np.mean(entropy_losses))
+        self.logger.record("train/policy_gradient_loss", np.mean(pg_losses))
+        self.logger.record("train/value_loss", np.mean(value_losses))
+        self.logger.record("train/approx_kl", np.mean(approx_kl_divs))
+        self.logger.record("train/clip_fraction", np.mean(clip_fractions))
+        self.logger.record("train/loss", loss.item())
+        self.logger.record("train/explained_variance", explained_var)
+        self.logger.record("train/n_updates", self._n_updates, exclude="tensorboard")
+        self.logger.record("train/clip_range", clip_range)
+        if clip_range_vf is not None:
+            self.logger.record("train/clip_range_vf", clip_range_vf)
+
+    def predict(self, observation, state=None, episode_start=None, deterministic: bool = False, action_masks=None):
+        """Actions and the next LSTM state; ``action_masks`` (n, 21) restricts the choice.
+
+        Args:
+            observation: (n, obs_dim) rows.
+            state: LSTM state returned by the previous call (None at the start).
+            episode_start: (n,) bool, True where an episode starts.
+            deterministic: most likely legal action instead of a sample.
+            action_masks: (n, sum(nvec)) legal actions, or None (unmasked).
+        """
+        return self.policy.predict(observation, state, episode_start, deterministic, action_masks=action_masks)
+
+    def learn(self, total_timesteps: int, callback=None, log_interval: int = 1,
+              tb_log_name: str = "MaskableRecurrentPPO", reset_num_timesteps: bool = True, progress_bar: bool = False):
+        return super().learn(total_timesteps=total_timesteps, callback=callback, log_interval=log_interval,
+                             tb_log_name=tb_log_name, reset_num_timesteps=reset_num_timesteps,
+                             progress_bar=progress_bar)

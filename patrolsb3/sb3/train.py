@@ -1,0 +1,235 @@
+"""``train()``: one parameter-shared training run, its run folder, and ``--resume``.
+
+Run folder ``<out>/<map>/<variant>/<run_id>/``::
+
+    model.zip          final model (SB3 zip)
+    checkpoints/       model_<timesteps>_steps.zip every ``checkpoint_freq`` agent-steps
+    config.yml         env config, map name and shape, algorithm hyperparameters, versions
+    command.txt        the command line(s) that made / resumed the run
+    curve.csv          one row per finished parallel episode (learning curve)
+    eval.csv           periodic evaluation on the paper metrics at 1..max_agents agents
+    tb/                TensorBoard logs (SB3 logger)
+
+Timesteps count agent-steps: vec-env rows (parallel episodes x max_agents slots) x env steps
+(two env steps per simulator step with same-step messages). Discounts are per simulator step
+in the hyperparameters and converted per env step (``gamma ** (1 / phases_per_step)``).
+"""
+from __future__ import annotations
+
+import re
+import sys
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from .algorithms import DEFAULT_ALGORITHM, get_algorithm
+from .curriculum import CURRICULUM, curriculum_stage
+from .hyperparams import load_hyperparams, merge, per_phase, schedule
+
+ALGO_KEYS = ("learning_rate", "n_steps", "n_epochs", "gamma", "gae_lambda", "clip_range", "ent_coef",
+             "vf_coef", "max_grad_norm", "n_minibatches", "batch_size", "policy_kwargs", "target_kl")
+RUN_KEYS = ("algo", "timesteps", "n_envs", "curriculum", "env", "checkpoint_freq", "eval_freq",
+            "eval_episode_steps", "eval_episodes", "torch_threads")
+CHECKPOINT_RE = re.compile(r"model_(\d+)_steps\.zip$")
+
+
+def curriculum_teams(n_envs: int, max_agents: int, curriculum=CURRICULUM) -> list[list[int]]:
+    """The curriculum for ``n_envs`` parallel episodes: the paper's 8 columns sampled evenly
+    (first and last kept) and team sizes capped at ``max_agents``."""
+    width = len(curriculum[0])
+    index = [0] if n_envs == 1 else [round(i * (width - 1) / (n_envs - 1)) for i in range(n_envs)]
+    return [[min(int(row[i]), max_agents) for i in index] for row in curriculum]
+
+
+def newest_checkpoint(run_dir: Path) -> Path | None:
+    """The checkpoint of ``run_dir/checkpoints`` with the most timesteps, or None."""
+    found = [(int(m.group(1)), p) for p in (run_dir / "checkpoints").glob("model_*_steps.zip")
+             if (m := CHECKPOINT_RE.search(p.name))]
+    return max(found)[1] if found else None
+
+
+def versions() -> dict:
+    """Versions of the packages a checkpoint depends on."""
+    import sb3_contrib
+    import stable_baselines3
+    import torch
+
+    from .. import __version__
+    from ..core.config import ENV_VERSION
+    return {"patrolsb3": str(__version__), "env_version": str(ENV_VERSION),
+            "stable_baselines3": str(stable_baselines3.__version__),
+            "sb3_contrib": str(sb3_contrib.__version__), "torch": str(torch.__version__), "numpy": str(np.__version__)}
+
+
+def resolve_hyperparams(map_name: str, hyperparams_file=None, overrides: dict | None = None) -> dict:
+    """Package (or file) hyperparameters of the map merged with ``overrides``.
+
+    Raises:
+        ValueError: an unknown key (the message lists the known ones).
+    """
+    hp = merge(load_hyperparams(map_name, hyperparams_file), overrides or {})
+    unknown = sorted(set(hp) - set(ALGO_KEYS) - set(RUN_KEYS))
+    if unknown:
+        raise ValueError(f"unknown hyperparameter(s) {unknown}; known: {sorted(ALGO_KEYS + RUN_KEYS)}")
+    return hp
+
+
+def algorithm_kwargs(hp: dict, spec, layout: dict, phases_per_step: int, rows: int) -> dict:
+    """Constructor arguments of the SB3 algorithm from resolved hyperparameters.
+
+    ``batch_size`` is ``n_steps * rows / n_minibatches`` unless given; gamma and GAE lambda
+    are converted per env step.
+    """
+    from .policy import policy_kwargs_for
+    n_steps = int(hp["n_steps"])
+    batch_size = hp.get("batch_size") or max(1, round(n_steps * rows / int(hp.get("n_minibatches", 1))))
+    policy_kwargs = {k: tuple(v) if isinstance(v, list) else v for k, v in (hp.get("policy_kwargs") or {}).items()}
+    unknown = sorted(set(policy_kwargs) - set(spec.policy_keys))
+    if unknown:
+        raise ValueError(f"policy_kwargs {unknown} do not apply to {spec.name}; known: {sorted(spec.policy_keys)}")
+    return dict(learning_rate=schedule(hp["learning_rate"]), n_steps=n_steps, batch_size=int(batch_size),
+                n_epochs=int(hp["n_epochs"]), gamma=per_phase(hp["gamma"], phases_per_step),
+                gae_lambda=per_phase(hp["gae_lambda"], phases_per_step), clip_range=float(hp["clip_range"]),
+                ent_coef=float(hp["ent_coef"]), vf_coef=float(hp["vf_coef"]),
+                max_grad_norm=float(hp["max_grad_norm"]), target_kl=hp.get("target_kl"),
+                policy_kwargs=policy_kwargs_for(layout, **policy_kwargs))
+
+
+def _check_resumable(run_dir: Path, config: dict) -> Path:
+    """The newest checkpoint of a run folder whose config matches this run's map and env."""
+    checkpoint = newest_checkpoint(run_dir)
+    if checkpoint is None:
+        raise FileNotFoundError(f"--resume: no checkpoint found in {run_dir / 'checkpoints'} "
+                                f"(looked for model_<steps>_steps.zip)")
+    saved_file = run_dir / "config.yml"
+    if saved_file.is_file():
+        saved = yaml.safe_load(saved_file.read_text()) or {}
+        for key in ("map", "map_shape", "variant", "algo"):
+            if saved.get(key) != config[key]:
+                raise ValueError(f"--resume: {run_dir} was trained with {key}={saved.get(key)!r}, "
+                                 f"this run asks for {config[key]!r}")
+        if saved.get("versions", {}).get("env_version") != config["versions"]["env_version"]:
+            raise ValueError(f"--resume: {run_dir} was trained on env version "
+                             f"{saved.get('versions', {}).get('env_version')!r}, this package has "
+                             f"{config['versions']['env_version']!r}")
+        if saved.get("env") != config["env"]:
+            raise ValueError(f"--resume: the env config of {run_dir} differs from this run's")
+    return checkpoint
+
+
+def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="runs/", algo: str | None = None,
+          seed: int = 0, resume: bool = False, hyperparams: dict | None = None, hyperparams_file=None,
+          n_envs: int | None = None, eval_freq: int | None = None, checkpoint_freq: int | None = None,
+          progress_bar: bool = True, verbose: int = 0, run_id: str | None = None, run_dir=None,
+          command: str | None = None) -> Path:
+    """Train a parameter-shared policy and write its run folder (see module docstring).
+
+    Args:
+        map: map name ("A" .. "D") or map file path.
+        variant: "rl-msg", "rl-no-msg" or "rl-intention".
+        timesteps: total agent-steps of the run (a resumed run trains up to this total).
+        out: root of the run folders.
+        algo: "MaskableRecurrentPPO" (default), "MaskablePPO" or "RecurrentPPO".
+        seed: seed of the env and the algorithm.
+        resume: continue the run folder from its newest checkpoint (step count, curriculum
+            stage and learning-rate schedule continue; curve.csv is appended).
+        hyperparams: overrides of the YAML hyperparameters (nested dicts merge).
+        hyperparams_file: a YAML keyed by map with a ``default:`` entry (default: the package's).
+        n_envs, eval_freq, checkpoint_freq: shortcuts overriding those hyperparameters.
+        progress_bar: SB3's tqdm/rich progress bar.
+        verbose: SB3 verbosity.
+        run_id: folder name of the run (default ``<algo>_seed<seed>``).
+        run_dir: the full run folder (overrides out/map/variant/run_id).
+        command: the command line recorded in command.txt (default: sys.argv).
+
+    Returns:
+        The run folder.
+
+    Raises:
+        ValueError: unknown algorithm / variant / hyperparameter, a run folder that exists
+            without ``resume``, or a resume against another map / env version.
+        FileNotFoundError: ``resume`` without a checkpoint (names where it looked).
+    """
+    import torch
+    from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
+
+    from ..core.maps import load_map
+    from .callbacks import LearningCurveCallback, PaperMetricsEvalCallback
+    from .curriculum import CurriculumCallback
+    from .variants import variant_overrides
+    from .vec_env import DEFAULT_AGENTS, make_vec_env
+
+    spec_map = load_map(map)
+    variant_overrides(variant)  # unknown variant -> ValueError listing the known ones
+    shortcuts = {k: v for k, v in dict(n_envs=n_envs, eval_freq=eval_freq, checkpoint_freq=checkpoint_freq,
+                                       algo=algo, timesteps=timesteps).items() if v is not None}
+    hp = resolve_hyperparams(spec_map.name, hyperparams_file, merge(hyperparams or {}, shortcuts))
+    spec = get_algorithm(hp.get("algo", DEFAULT_ALGORITHM))
+    total = int(hp["timesteps"])
+    torch.set_num_threads(int(hp.get("torch_threads", 1)))
+    env_kwargs = dict(hp.get("env") or {})
+
+    from ..core.config import make_config
+    cfg = make_config(spec_map.name, **variant_overrides(variant), **env_kwargs)
+    n_par = int(hp.get("n_envs", 8))
+    teams = curriculum_teams(n_par, min(cfg.max_agents, spec_map.n_vertices))
+    final_teams = [min(k, cfg.max_agents, spec_map.n_vertices) for k in
+                   (DEFAULT_AGENTS if n_par == len(DEFAULT_AGENTS) else teams[-1])]
+
+    run_dir = Path(run_dir) if run_dir is not None else \
+        Path(out) / spec_map.name / variant / (run_id or f"{spec.name}_seed{seed}")
+    config = {"map": spec_map.name, "map_source": str(spec_map.source), "map_shape": list(spec_map.shape),
+              "variant": variant, "algo": spec.name, "seed": int(seed), "timesteps": total,
+              "env": cfg.to_dict(), "hyperparams": hp, "versions": versions()}
+    checkpoint = None
+    if resume:
+        checkpoint = _check_resumable(run_dir, config)
+    elif run_dir.exists() and any(run_dir.iterdir()):
+        raise ValueError(f"run folder {run_dir} exists; pass --resume to continue it or --run-id to start another")
+    (run_dir / "checkpoints").mkdir(parents=True, exist_ok=True)
+    if not resume:
+        (run_dir / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
+    with (run_dir / "command.txt").open("a") as f:
+        f.write((command or " ".join(sys.argv)) + "\n")
+
+    cls, policy_cls = spec.classes()
+    start_teams = teams[0] if hp.get("curriculum", True) else final_teams
+    vec_env = make_vec_env(spec_map, agents=start_teams, variant=variant, seed=seed, strict=spec.masked,
+                           **env_kwargs)
+    rows = vec_env.num_envs
+    if checkpoint is not None:
+        model = cls.load(checkpoint, env=vec_env, device="cpu", tensorboard_log=str(run_dir / "tb"),
+                         verbose=verbose)
+        model._last_obs = None  # the saved observation belongs to the old env: learn() resets
+        if verbose:
+            print(f"resuming {run_dir} from {checkpoint.name} at {model.num_timesteps} timesteps")
+    else:
+        kwargs = algorithm_kwargs(hp, spec, vec_env.layout, vec_env.phases_per_step, rows)
+        model = cls(policy_cls, vec_env, tensorboard_log=str(run_dir / "tb"), seed=seed, verbose=verbose,
+                    device="cpu", **kwargs)
+
+    max_agents = vec_env.layout["critic_size"] // 3
+    eval_teams = [k for k in range(1, max_agents + 1) if k <= spec_map.n_vertices] * int(hp.get("eval_episodes", 1))
+    eval_env_kwargs = {**env_kwargs, "episode_steps": int(hp.get("eval_episode_steps", 500))}
+
+    def make_eval_env():
+        return make_vec_env(spec_map, agents=eval_teams, variant=variant, seed=seed + 10_000,
+                            strict=spec.masked, **eval_env_kwargs)
+
+    callbacks = [CheckpointCallback(save_freq=max(1, int(hp.get("checkpoint_freq", 200_000)) // rows),
+                                    save_path=str(run_dir / "checkpoints"), name_prefix="model"),
+                 LearningCurveCallback(run_dir / "curve.csv", max_agents),
+                 PaperMetricsEvalCallback(make_eval_env, run_dir / "eval.csv", int(hp.get("eval_freq", 0)))]
+    if hp.get("curriculum", True):
+        callbacks.insert(0, CurriculumCallback(total, curriculum=teams))
+    remaining = total - model.num_timesteps
+    try:
+        if remaining > 0:
+            model.learn(remaining, callback=CallbackList(callbacks), reset_num_timesteps=checkpoint is None,
+                        progress_bar=progress_bar, tb_log_name=spec.name)
+    finally:
+        model.save(run_dir / "checkpoints" / f"model_{model.num_timesteps}_steps.zip")
+        vec_env.close()
+    model.save(run_dir / "model.zip")
+    return run_dir
