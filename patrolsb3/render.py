@@ -261,9 +261,7 @@ def draw_map_png(spec: MapSpec, path, tile: int = TILE) -> Path:
     Returns:
         The path written.
     """
-    import matplotlib
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
     from matplotlib.patches import Patch
 
     H, W = spec.shape
@@ -272,7 +270,8 @@ def draw_map_png(spec: MapSpec, path, tile: int = TILE) -> Path:
     tinted = (tint > 0) & (image == EMPTY_RGB).all(axis=-1)
     strength = (0.25 + 0.05 * tint[tinted])[:, None]
     image[tinted] = ((1 - strength) * np.array(EMPTY_RGB) + strength * np.array(PRIORITY_RGB)).astype(np.uint8)
-    fig, ax = plt.subplots(figsize=(1.6 + W * 0.38, 0.9 + H * 0.38), dpi=100)
+    fig = Figure(figsize=(1.6 + W * 0.38, 0.9 + H * 0.38), dpi=100)   # no pyplot: no window
+    ax = fig.subplots()
     ax.imshow(image, interpolation="nearest", extent=(-0.5, W - 0.5, H - 0.5, -0.5))
     for r, c in zip(*np.nonzero(spec.priority)):
         ax.text(c, r, str(int(spec.priority[r, c])), ha="center", va="center", fontsize=10,
@@ -294,7 +293,6 @@ def draw_map_png(spec: MapSpec, path, tile: int = TILE) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, bbox_inches="tight")
-    plt.close(fig)
     return path
 
 
@@ -310,9 +308,7 @@ def plot_idleness_heatmap(spec: MapSpec, mean_idleness_per_vertex, path, title: 
     Returns:
         The path written.
     """
-    import matplotlib
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     values = np.asarray(mean_idleness_per_vertex, dtype=np.float64)
     if values.shape != (spec.n_vertices,):
@@ -321,7 +317,8 @@ def plot_idleness_heatmap(spec: MapSpec, mean_idleness_per_vertex, path, title: 
     H, W = spec.shape
     grid = np.full(H * W, np.nan)                                                  # (H*W,)
     grid[spec.vertex_cells] = values
-    fig, ax = plt.subplots(figsize=(1.8 + W * 0.4, 0.8 + H * 0.4), dpi=100)
+    fig = Figure(figsize=(1.8 + W * 0.4, 0.8 + H * 0.4), dpi=100)
+    ax = fig.subplots()
     ax.imshow(np.where(spec.kinds == OBSTACLE, 1.0, np.nan), cmap="Greys", vmin=0, vmax=1.4,
               interpolation="nearest")
     im = ax.imshow(np.ma.masked_invalid(grid.reshape(H, W)), cmap="YlOrRd", interpolation="nearest")
@@ -335,5 +332,4 @@ def plot_idleness_heatmap(spec: MapSpec, mean_idleness_per_vertex, path, title: 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, bbox_inches="tight")
-    plt.close(fig)
     return path
