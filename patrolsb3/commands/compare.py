@@ -1,9 +1,72 @@
-"""``patrolsb3 compare``: not implemented yet (placeholder to be replaced by its owner)."""
+"""``patrolsb3 compare``: every strategy x maps x team sizes -> the paper's tables, a markdown
+report and plots (see ``patrolsb3.report``). Zoo columns (INTENTION, NOMSG, MSG) are filled
+when ``patrolsb3.zoo`` has a model for the map, empty otherwise."""
+
+
+def parse_agents(text: str) -> list[int]:
+    """'1-5' or '1,3,5' (or a mix) -> sorted team sizes."""
+    sizes = set()
+    try:
+        for part in str(text).split(","):
+            if "-" in part:
+                low, high = (int(v) for v in part.split("-"))
+                sizes.update(range(low, high + 1))
+            elif part.strip():
+                sizes.add(int(part))
+    except ValueError:
+        raise ValueError(f"bad --agents {text!r}: expected sizes like 1-5 or 1,3,5") from None
+    if not sizes or min(sizes) < 1:
+        raise ValueError(f"bad --agents {text!r}: team sizes must be >= 1")
+    return sorted(sizes)
 
 
 def add_arguments(parser):
-    pass
+    parser.add_argument("--maps", default="A,B,C,D", help="comma-separated maps (default A,B,C,D)")
+    parser.add_argument("--agents", default="1-5", help="team sizes, e.g. 1-5 or 1,3,5 (default 1-5)")
+    parser.add_argument("--episodes", type=int, default=20, help="episodes per test (default 20)")
+    parser.add_argument("--steps", type=int, default=14400, help="steps per episode (default 14400)")
+    parser.add_argument("--tests", type=int, default=1, help="tests (default 1)")
+    parser.add_argument("--strategies", default=None,
+                        help="comma-separated strategies (default: CR,PART,SEBS,RANDOM,CYCLIC and the "
+                             "zoo models available for each map)")
+    parser.add_argument("--protocol", choices=["paper"], default=None,
+                        help="'paper': 10 tests x 100 episodes x 14,400 steps")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", required=True, help="output folder")
+    parser.add_argument("--no-progress", action="store_true")
 
 
 def run(args):
-    raise NotImplementedError("patrolsb3 compare is not implemented yet")
+    import importlib
+
+    from ..evaluate import evaluate
+    from ..report import EXTRA_COLUMNS, ZOO_COLUMNS, write_compare
+    if args.protocol == "paper":
+        args.tests, args.episodes, args.steps = 10, 100, 14400
+    maps = [m.strip() for m in args.maps.split(",") if m.strip()]
+    sizes = parse_agents(args.agents)
+    try:
+        zoo = importlib.import_module("patrolsb3.zoo")
+    except ImportError:
+        zoo = None
+    results = []
+    for m in maps:
+        if args.strategies:
+            names = [s.strip() for s in args.strategies.split(",") if s.strip()]
+        else:
+            names = ["CR", "PART", "SEBS", *EXTRA_COLUMNS]
+            if zoo is not None:
+                names += [s for s in ZOO_COLUMNS.values() if zoo.available(m, s.split(":", 1)[1])]
+        for name in names:
+            for n in sizes:
+                r = evaluate(name, m, n, episodes=args.episodes, tests=args.tests, steps=args.steps,
+                             seed=args.seed, progress=not args.no_progress)
+                s = r["summary"]
+                print(f"map {r['map']} {name:>16} n={n}: MAX {s['max_idleness']['mean']:.1f} "
+                      f"AVG {s['avg_idleness']['mean']:.1f} col {s['collisions']['mean']:.2f} "
+                      f"BF {s['battery_failure_rate']['mean']:.3f} BLv {s['swap_battery_pct']['mean']:.1f}",
+                      flush=True)
+                results.append(r)
+    paths = write_compare(results, args.out)
+    print(f"wrote {len(paths)} files to {args.out} (report: {args.out}/report.md)")
+    return 0

@@ -1,9 +1,30 @@
-"""``patrolsb3 evaluate``: not implemented yet (placeholder to be replaced by its owner)."""
+"""``patrolsb3 evaluate``: one strategy on one map with the paper's metrics (mean +- std over tests)."""
+import json
 
 
 def add_arguments(parser):
-    pass
+    parser.add_argument("--strategy", required=True,
+                        help="RANDOM, CR, PART, SEBS, CYCLIC (case-insensitive) or zoo:<variant>")
+    parser.add_argument("--map", default="A", help="map name A-D or a map file (default A)")
+    parser.add_argument("--agents", type=int, default=3, help="team size (default 3)")
+    parser.add_argument("--episodes", type=int, default=100, help="episodes per test (default 100)")
+    parser.add_argument("--steps", type=int, default=14400, help="steps per episode (default 14400 = 24 h)")
+    parser.add_argument("--tests", type=int, default=1, help="tests; mean +- std over them (default 1)")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--faults", action="append", default=[], metavar="STEP:K",
+                        help="K agents fail for good at STEP (repeatable); AVG/MAX are split at each")
+    parser.add_argument("--json", default=None, metavar="FILE", help="also write the result as JSON")
+    parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
 
 
 def run(args):
-    raise NotImplementedError("patrolsb3 evaluate is not implemented yet")
+    from ..evaluate import evaluate, parse_faults
+    from ..report import evaluation_text
+    result = evaluate(args.strategy, args.map, args.agents, episodes=args.episodes, tests=args.tests,
+                      steps=args.steps, seed=args.seed, faults=parse_faults(args.faults),
+                      progress=not args.no_progress)
+    print(evaluation_text(result))
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(result, fh, indent=2)
+    return 0

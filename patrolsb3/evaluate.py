@@ -1,0 +1,191 @@
+"""Run a strategy over batched episodes and summarise the paper's metrics over tests.
+
+All episodes of one configuration (tests x episodes) step together on the batched core:
+``policy.predict(sim_state, memory, episode_start)`` -> actions (E, A, 2), then
+``core.step(spec, cfg, sim, actions[..., 1], messages=actions[..., 0], compute_reward=False)``
+with ``invalid_action='raise'``. A heuristic (``patrolsb3.strategies``) and a zoo model
+(``zoo:<variant>``, loaded by ``patrolsb3.zoo.load(map, variant)``) are treated the same way.
+
+Tests: episode e belongs to test ``e // episodes``. Per test, idleness and collision figures
+average over the episodes *without* a battery failure (as in the paper; the count is kept),
+the battery failure rate is the share of episodes with >= 1 failure, and the battery level at
+recharge averages over every swap of the test. The summary is mean and std over tests.
+"""
+from __future__ import annotations
+
+import importlib
+import warnings
+
+import numpy as np
+
+from .core.config import make_config
+from .core.maps import load_map
+from .core.metrics import EpisodeMetrics, idleness_lower_bounds
+from .core.state import reset_state
+from .core.step import step
+
+CLEAN_METRICS = ("avg_idleness", "max_idleness", "worst_idleness", "std_idleness", "collisions")
+"""Averaged over episodes without a battery failure."""
+ALL_METRICS = ("battery_failures", "battery_failure_rate", "swap_battery_pct")
+"""Averaged over every episode (or swap)."""
+
+
+def parse_faults(texts) -> tuple:
+    """Parse ``STEP:K`` strings into ((step, k), ...).
+
+    Raises:
+        ValueError: a string not of the form STEP:K with integers STEP >= 0 and K >= 1.
+    """
+    faults = []
+    for text in texts or ():
+        parts = str(text).split(":")
+        try:
+            if len(parts) != 2:
+                raise ValueError
+            fault_step, k = int(parts[0]), int(parts[1])
+        except ValueError:
+            raise ValueError(f"bad --faults {text!r}: expected STEP:K with integers, e.g. 7200:1 "
+                             f"(K agents fail for good at step STEP)") from None
+        if fault_step < 0 or k < 1:
+            raise ValueError(f"bad --faults {text!r}: STEP must be >= 0 and K >= 1")
+        faults.append((fault_step, k))
+    return tuple(sorted(faults))
+
+
+def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0):
+    """A heuristic by name, or ``zoo:<variant>`` through ``patrolsb3.zoo.load(map, variant)``.
+
+    Raises:
+        ValueError: unknown strategy, or a zoo strategy when no zoo module or model exists.
+    """
+    if str(name).lower().startswith("zoo:"):
+        variant = str(name).split(":", 1)[1]
+        try:
+            zoo = importlib.import_module("patrolsb3.zoo")
+        except ImportError as exc:
+            raise ValueError(f"strategy {name!r} needs patrolsb3.zoo, which cannot be imported: {exc}") from exc
+        try:
+            return zoo.load(spec.name, variant, spec=spec)
+        except (ValueError, FileNotFoundError) as exc:
+            raise ValueError(f"strategy {name!r}: {exc}") from exc
+    from . import strategies
+    return strategies.get(name, spec, n_agents, cfg=cfg, seed=seed)
+
+
+def run_episodes(policy, spec, cfg, n_agents: int, n_envs: int, seed: int = 0, progress=False,
+                 desc: str = "") -> dict:
+    """Run ``n_envs`` episodes of ``cfg.episode_steps`` steps together.
+
+    Args:
+        policy: any object with SB3's ``predict(sim_state, state, episode_start, deterministic)``.
+        spec: the map.
+        cfg: environment parameters (its ``faults`` also set the metric segments).
+        n_agents: team size of every episode.
+        n_envs: episodes E.
+        seed: seed of the simulator.
+        progress: show a tqdm progress bar over steps.
+        desc: label of the progress bar.
+
+    Returns:
+        The per-episode figures of :meth:`EpisodeMetrics.result` plus ``segments``.
+    """
+    sim = reset_state(spec, cfg, n_agents, n_envs=n_envs, seed=seed)
+    metrics = EpisodeMetrics(n_envs, spec.n_vertices, boundaries=[s + 1 for s, _ in cfg.faults])
+    memory = None
+    episode_start = np.ones(n_envs, dtype=bool)
+    steps = range(cfg.episode_steps)
+    if progress:
+        from tqdm import tqdm
+        steps = tqdm(steps, desc=desc, unit="step", leave=False, mininterval=0.5)
+    for _ in steps:
+        actions, memory = policy.predict(sim, state=memory, episode_start=episode_start,
+                                         deterministic=True)
+        info = step(spec, cfg, sim, actions[..., 1], messages=actions[..., 0], compute_reward=False)
+        metrics.update(sim, info)
+        episode_start[:] = False
+    result = metrics.result()
+    result["segments"] = metrics.segments()
+    return result
+
+
+def summarize(per_episode: dict, tests: int) -> dict:
+    """Per-test figures and their mean / std over tests.
+
+    Args:
+        per_episode: output of :func:`run_episodes` (E = tests x episodes).
+        tests: number of tests.
+
+    Returns:
+        dict metric -> {"mean", "std", "tests": [per-test values]}, plus ``clean_episodes``
+        (per-test counts of episodes without a battery failure) and ``segments``.
+    """
+    failed = per_episode["failed"].reshape(tests, -1)                        # (T, N)
+    clean = ~failed
+    out = {}
+
+    def stats(values):
+        values = np.asarray(values, dtype=np.float64)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return {"mean": float(np.nanmean(values)) if np.isfinite(values).any() else float("nan"),
+                    "std": float(np.nanstd(values)) if np.isfinite(values).any() else float("nan"),
+                    "tests": [float(v) for v in values]}
+
+    def clean_mean(x):
+        x = x.reshape(tests, -1)
+        n = clean.sum(axis=1)
+        return np.where(n > 0, np.where(clean, x, 0.0).sum(axis=1) / np.maximum(n, 1), np.nan)
+
+    for name in CLEAN_METRICS:
+        out[name] = stats(clean_mean(per_episode[name]))
+    out["battery_failures"] = stats(per_episode["battery_failures"].reshape(tests, -1).mean(axis=1))
+    out["battery_failure_rate"] = stats(failed.mean(axis=1))
+    swaps = per_episode["swaps"].reshape(tests, -1)
+    level = np.nan_to_num(per_episode["swap_battery"]).reshape(tests, -1) * swaps
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out["swap_battery_pct"] = stats(100.0 * level.sum(axis=1) / swaps.sum(axis=1))
+    out["clean_episodes"] = [int(n) for n in clean.sum(axis=1)]
+    out["segments"] = [{"start": s["start"], "end": s["end"],
+                        "avg_idleness": stats(clean_mean(s["avg"])),
+                        "max_idleness": stats(clean_mean(s["max"]))}
+                       for s in per_episode.get("segments", [])]
+    return out
+
+
+def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100, tests: int = 1,
+             steps: int = 14400, seed: int = 0, faults=(), progress: bool = True, **env) -> dict:
+    """Evaluate one strategy on one map and team size (the ``patrolsb3 evaluate`` command).
+
+    Args:
+        strategy: RANDOM, CR, PART, SEBS, CYCLIC or zoo:<variant>.
+        map_name: a shipped map name or a map file.
+        n_agents: team size.
+        episodes: episodes per test.
+        tests: tests (the summary is mean +- std over them).
+        steps: steps per episode (14,400 = 24 h).
+        seed: seed of the simulator and the strategy.
+        faults: ((step, k), ...) scheduled hardware failures.
+        progress: show a progress bar.
+        **env: other EnvConfig fields (e.g. p_dyn_max=0).
+
+    Returns:
+        A JSON-friendly dict: the configuration, ``summary`` (see :func:`summarize`) and
+        ``bounds`` (:func:`idleness_lower_bounds`).
+    """
+    spec = load_map(map_name)
+    if episodes < 1 or tests < 1 or steps < 1:
+        raise ValueError(f"episodes, tests and steps must be >= 1 (got {episodes}, {tests}, {steps})")
+    max_agents = max(env.pop("max_agents", 5), n_agents)
+    cfg = make_config(spec.name if spec.name in "ABCD" else None, max_agents=max_agents,
+                      episode_steps=steps, faults=tuple(faults), invalid_action="raise", **env)
+    policy = load_policy(strategy, spec, n_agents, cfg, seed=seed)
+    policy_cfg = getattr(policy, "cfg", None)
+    if policy_cfg is not None and policy_cfg.max_agents != cfg.max_agents:
+        cfg = make_config(None, **{**cfg.to_dict(), "max_agents": policy_cfg.max_agents})
+    per_episode = run_episodes(policy, spec, cfg, n_agents, tests * episodes, seed=seed,
+                               progress=progress, desc=f"{strategy} map {spec.name} n={n_agents}")
+    return {"strategy": str(strategy), "map": spec.name, "n_agents": int(n_agents),
+            "episodes": int(episodes), "tests": int(tests), "steps": int(steps), "seed": int(seed),
+            "faults": [list(f) for f in faults], "env": cfg.to_dict(),
+            "summary": summarize(per_episode, tests),
+            "bounds": idleness_lower_bounds(spec.n_vertices, n_agents, steps)}

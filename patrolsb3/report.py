@@ -1,0 +1,170 @@
+"""The one writer of every table and plot of evaluations.
+
+* :func:`evaluation_text` — the terminal / markdown table of one ``evaluate()`` result.
+* :func:`write_compare` — per map the paper's CSV tables ``<MAP>-BF.csv``, ``-BLv.csv``,
+  ``-MAX.csv``, ``-MEAN.csv``, ``-COLLISION.csv`` with columns ``n,CR,PART,SEBS,INTENTION,
+  NOMSG,MSG`` (cells are means over tests; a strategy that was not run is an empty cell),
+  the same tables for the extra strategies in ``<MAP>-<TABLE>-extra.csv`` (columns
+  ``n,RANDOM,CYCLIC``), every figure with its std in ``results.csv`` (long format), one
+  ``report.md`` with all tables as mean +- std, and one PNG per map (idleness per team size,
+  collisions, battery).
+"""
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+PAPER_TABLES = {"BF": "battery_failure_rate", "BLv": "swap_battery_pct", "MAX": "max_idleness",
+                "MEAN": "avg_idleness", "COLLISION": "collisions"}
+"""Paper table suffix -> metric key of the summary."""
+PAPER_COLUMNS = ("CR", "PART", "SEBS", "INTENTION", "NOMSG", "MSG")
+EXTRA_COLUMNS = ("RANDOM", "CYCLIC")
+ZOO_COLUMNS = {"INTENTION": "zoo:rl-intention", "NOMSG": "zoo:rl-no-msg", "MSG": "zoo:rl-msg"}
+"""Paper column -> strategy name that fills it."""
+LABELS = {"avg_idleness": "AVG^h", "max_idleness": "MAX^h", "worst_idleness": "worst idleness",
+          "std_idleness": "std across vertices", "collisions": "collisions / episode",
+          "battery_failures": "battery failures / episode",
+          "battery_failure_rate": "battery failure rate", "swap_battery_pct": "battery % at swap start"}
+
+
+def column_strategy(column: str) -> str:
+    """Strategy name behind a table column (heuristic names are their own)."""
+    return ZOO_COLUMNS.get(column, column)
+
+
+def mean_std(stat: dict, digits: int = 1) -> str:
+    """'mean +- std' of a summary entry, '' when missing or nan."""
+    if not stat or stat.get("mean") is None or math.isnan(stat["mean"]):
+        return ""
+    return f"{stat['mean']:.{digits}f} +- {stat['std']:.{digits}f}"
+
+
+def evaluation_text(result: dict) -> str:
+    """A markdown table of one evaluation, with the bounds and fault segments."""
+    s = result["summary"]
+    tests, episodes = result["tests"], result["episodes"]
+    lines = [f"{result['strategy']} on map {result['map']}, {result['n_agents']} agent(s): "
+             f"{tests} test(s) x {episodes} episodes x {result['steps']} steps (mean +- std over tests)",
+             "", "| metric | value |", "|---|---|"]
+    for key, label in LABELS.items():
+        digits = 3 if key == "battery_failure_rate" else 2
+        note = " (episodes without battery failure)" if key in ("avg_idleness", "max_idleness",
+                                                                "worst_idleness", "std_idleness",
+                                                                "collisions") else ""
+        lines.append(f"| {label}{note} | {mean_std(s[key], digits)} |")
+    clean = s["clean_episodes"]
+    lines.append(f"| episodes without battery failure | {sum(clean)} of {tests * episodes} |")
+    b = result["bounds"]
+    lines.append(f"| lower bound |V|/k | {b['v_over_k']:.1f} (worst idleness >= {b['worst']:.0f}, "
+                 f"AVG^h and MAX^h >= {b['avg']:.1f}) |")
+    for seg in s.get("segments", []):
+        lines.append(f"| steps {seg['start']}-{seg['end']}: AVG^h / MAX^h | "
+                     f"{mean_std(seg['avg_idleness'])} / {mean_std(seg['max_idleness'])} |")
+    return "\n".join(lines)
+
+
+def _table_rows(results: list[dict], map_name: str, metric: str, columns) -> list[list]:
+    by_key = {(r["map"], r["n_agents"], r["strategy"]): r for r in results}
+    ns = sorted({r["n_agents"] for r in results if r["map"] == map_name})
+    rows = []
+    for n in ns:
+        row = [n]
+        for col in columns:
+            r = by_key.get((map_name, n, column_strategy(col)))
+            row.append(r["summary"][metric] if r else None)
+        rows.append(row)
+    return rows
+
+
+def write_compare(results: list[dict], out_dir, plots: bool = True) -> list[Path]:
+    """Write every table, the report and the plots of a comparison.
+
+    Args:
+        results: ``evaluate()`` results (any maps, team sizes and strategies).
+        out_dir: output folder (created).
+        plots: also draw the PNG plots.
+
+    Returns:
+        The paths written.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    maps = sorted({r["map"] for r in results})
+    md = ["# Strategy comparison", ""]
+    if results:
+        r0 = results[0]
+        md += [f"{r0['tests']} test(s) x {r0['episodes']} episodes x {r0['steps']} steps per "
+               f"(map, strategy, team size); mean +- std over tests. Idleness and collision figures "
+               f"average over episodes without a battery failure (counts in results.csv).", ""]
+    for m in maps:
+        for suffix, metric in PAPER_TABLES.items():
+            md += [f"## Map {m}: {suffix} ({LABELS[metric]})", ""]
+            for columns, name in ((PAPER_COLUMNS, f"{m}-{suffix}.csv"),
+                                  (EXTRA_COLUMNS, f"{m}-{suffix}-extra.csv")):
+                rows = _table_rows(results, m, metric, columns)
+                path = out / name
+                with path.open("w", newline="") as fh:
+                    writer = csv.writer(fh)
+                    writer.writerow(["n", *columns])
+                    for row in rows:
+                        writer.writerow([row[0]] + ["" if s is None or math.isnan(s["mean"])
+                                                    else f"{s['mean']:.6g}" for s in row[1:]])
+                written.append(path)
+            rows_all = _table_rows(results, m, metric, PAPER_COLUMNS + EXTRA_COLUMNS)
+            digits = 3 if metric == "battery_failure_rate" else 1
+            md.append("| n | " + " | ".join(PAPER_COLUMNS + EXTRA_COLUMNS) + " |")
+            md.append("|---" * (1 + len(PAPER_COLUMNS + EXTRA_COLUMNS)) + "|")
+            for row in rows_all:
+                md.append(f"| {row[0]} | " + " | ".join(mean_std(s, digits) for s in row[1:]) + " |")
+            md.append("")
+        if plots:
+            png = plot_map(results, m, out / f"{m}.png")
+            md += [f"![map {m}]({png.name})", ""]
+            written.append(png)
+    long_path = out / "results.csv"
+    with long_path.open("w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(["map", "n", "strategy", "metric", "mean", "std", "clean_episodes",
+                         "episodes", "tests", "steps"])
+        for r in results:
+            for metric in LABELS:
+                s = r["summary"][metric]
+                writer.writerow([r["map"], r["n_agents"], r["strategy"], metric, s["mean"], s["std"],
+                                 sum(r["summary"]["clean_episodes"]), r["episodes"] * r["tests"],
+                                 r["tests"], r["steps"]])
+    written.append(long_path)
+    report = out / "report.md"
+    report.write_text("\n".join(md) + "\n")
+    written.append(report)
+    return written
+
+
+def plot_map(results: list[dict], map_name: str, path) -> Path:
+    """One PNG per map: MAX^h, AVG^h, collisions, battery failure rate and battery % at swap
+    start against team size, one line (with std error bars) per strategy."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    panels = ("max_idleness", "avg_idleness", "collisions", "battery_failure_rate", "swap_battery_pct")
+    fig, axes = plt.subplots(1, len(panels), figsize=(4 * len(panels), 3.5))
+    rows = [r for r in results if r["map"] == map_name]
+    for strategy in sorted({r["strategy"] for r in rows}):
+        mine = sorted((r for r in rows if r["strategy"] == strategy), key=lambda r: r["n_agents"])
+        ns = [r["n_agents"] for r in mine]
+        for ax, metric in zip(axes, panels):
+            ax.errorbar(ns, [r["summary"][metric]["mean"] for r in mine],
+                        yerr=[r["summary"][metric]["std"] for r in mine], marker="o", capsize=3,
+                        label=strategy)
+    for ax, metric in zip(axes, panels):
+        ax.set_title(LABELS[metric])
+        ax.set_xlabel("agents")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(f"map {map_name}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+    return Path(path)
