@@ -104,7 +104,7 @@ def run_episodes(policy, spec, cfg, n_agents: int, n_envs: int, seed: int = 0, p
         metrics.update(sim, info)
         episode_start[:] = False
     result = metrics.result()
-    result["segments"] = metrics.segments()
+    result["segments"] = metrics.segments() if cfg.faults else []
     return result
 
 
@@ -175,7 +175,9 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
     spec = load_map(map_name)
     if episodes < 1 or tests < 1 or steps < 1:
         raise ValueError(f"episodes, tests and steps must be >= 1 (got {episodes}, {tests}, {steps})")
-    max_agents = max(env.pop("max_agents", 5), n_agents)
+    max_agents = env.pop("max_agents", 5)
+    if not 1 <= n_agents <= max_agents:
+        raise ValueError(f"team of {n_agents} agents does not fit: 1 <= agents <= max_agents={max_agents}")
     cfg = make_config(spec.name if spec.name in "ABCD" else None, max_agents=max_agents,
                       episode_steps=steps, faults=tuple(faults), invalid_action="raise", **env)
     policy = load_policy(strategy, spec, n_agents, cfg, seed=seed)

@@ -44,7 +44,7 @@ class HeuristicPolicy:
 
     def __init__(self, spec, n_agents: int, cfg: EnvConfig | None = None, seed: int = 0):
         self.spec: MapSpec = load_map(spec)
-        self.cfg = cfg if cfg is not None else make_config(self.spec.name, max_agents=max(5, n_agents))
+        self.cfg = cfg if cfg is not None else make_config(self.spec.name)
         if n_agents < 1 or n_agents > self.cfg.max_agents:
             raise ValueError(f"team of {n_agents} agents does not fit max_agents={self.cfg.max_agents}")
         self.n_agents = int(n_agents)

@@ -1,0 +1,112 @@
+"""Batched evaluation: fault parsing, summaries over tests, any predict() object, the CLI."""
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from patrolsb3 import cli
+from patrolsb3.core import load_map, make_config
+from patrolsb3.evaluate import evaluate, load_policy, parse_faults, run_episodes, summarize
+
+
+def test_parse_faults():
+    assert parse_faults(["7200:1", "100:2"]) == ((100, 2), (7200, 1))
+    for bad in ["12x", "1:2:3", "5:0", "-1:1"]:
+        with pytest.raises(ValueError, match="bad --faults"):
+            parse_faults([bad])
+
+
+def test_summarize_over_tests_by_hand():
+    per_episode = {
+        "avg_idleness": np.array([10.0, 20.0, 30.0, 50.0]),
+        "max_idleness": np.array([1.0, 2.0, 3.0, 5.0]),
+        "worst_idleness": np.zeros(4), "std_idleness": np.zeros(4),
+        "collisions": np.array([1.0, 3.0, 5.0, 7.0]),
+        "battery_failures": np.array([0.0, 2.0, 0.0, 0.0]),
+        "failed": np.array([False, True, False, False]),
+        "swap_battery": np.array([0.2, np.nan, 0.3, 0.1]),
+        "swaps": np.array([1, 0, 2, 2]),
+    }
+    s = summarize(per_episode, tests=2)
+    # test 0: only episode 0 is clean; test 1: both
+    assert s["avg_idleness"]["tests"] == [10.0, 40.0]
+    assert s["avg_idleness"]["mean"] == 25.0 and s["avg_idleness"]["std"] == 15.0
+    assert s["collisions"]["tests"] == [1.0, 6.0]
+    assert s["battery_failure_rate"]["tests"] == [0.5, 0.0]
+    assert s["battery_failures"]["tests"] == [1.0, 0.0]
+    assert s["swap_battery_pct"]["tests"] == pytest.approx([20.0, 20.0])
+    assert s["clean_episodes"] == [1, 2]
+
+
+def test_evaluate_with_fault_splits_segments():
+    r = evaluate("PART", "A", 1, episodes=3, tests=2, steps=300, seed=1, faults=((99, 1),),
+                 progress=False)
+    s = r["summary"]
+    assert (r["map"], r["n_agents"], r["tests"], len(s["clean_episodes"])) == ("A", 1, 2, 2)
+    before, after = s["segments"]
+    assert (before["start"], before["end"], after["start"], after["end"]) == (0, 100, 100, 300)
+    # the only agent fails for good at step 99: nobody resets idleness afterwards
+    assert after["avg_idleness"]["mean"] > before["avg_idleness"]["mean"] + 100
+    assert r["bounds"]["v_over_k"] == load_map("A").n_vertices
+
+
+class CountingPolicy:
+    """A recurrent-style predictor: its state counts steps and resets on episode_start."""
+
+    def __init__(self):
+        self.starts = []
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        E, A = observation.pos.shape
+        self.starts.append(np.asarray(episode_start).copy())
+        state = np.zeros(E, dtype=int) if state is None else state
+        state = np.where(episode_start, 0, state) + 1
+        actions = np.zeros((E, A, 2), dtype=np.int64)
+        actions[..., 1] = 4
+        return actions, state
+
+
+def test_any_predictor_is_driven_alike():
+    spec = load_map("B")
+    cfg = make_config("B", episode_steps=5)
+    policy = CountingPolicy()
+    r = run_episodes(policy, spec, cfg, 2, n_envs=3, seed=0)
+    assert [s.tolist() for s in policy.starts] == [[True] * 3] + [[False] * 3] * 4
+    # nobody moves: every vertex but the starting ones grows by its rate each step
+    assert r["collisions"].tolist() == [0.0, 0.0, 0.0]
+
+
+def test_unknown_zoo_strategy_is_a_clear_error():
+    spec = load_map("A")
+    with pytest.raises(ValueError, match="zoo:nothing"):
+        load_policy("zoo:nothing", spec, 2, make_config("A"))
+
+
+def test_cli_evaluate_writes_json(tmp_path, capsys):
+    out = tmp_path / "r.json"
+    assert cli.main(["evaluate", "--strategy", "cr", "--map", "C", "--agents", "2", "--episodes", "2",
+                     "--steps", "50", "--json", str(out), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "MAX^h" in text and "battery failure rate" in text and "|V|/k" in text
+    result = json.loads(out.read_text())
+    assert result["strategy"] == "cr" and result["summary"]["clean_episodes"] == [2]
+    assert cli.main(["evaluate", "--strategy", "nope", "--episodes", "1", "--steps", "2"]) == 2
+    assert cli.main(["evaluate", "--strategy", "CR", "--agents", "7", "--episodes", "1",
+                     "--steps", "2"]) == 2
+    assert "nope" in capsys.readouterr().err
+
+
+def test_cli_compare_writes_paper_tables(tmp_path):
+    assert cli.main(["compare", "--maps", "A", "--agents", "1-2", "--episodes", "2", "--steps", "40",
+                     "--out", str(tmp_path), "--no-progress"]) == 0
+    for suffix in ("BF", "BLv", "MAX", "MEAN", "COLLISION"):
+        rows = list(csv.reader((tmp_path / f"A-{suffix}.csv").open()))
+        assert rows[0] == ["n", "CR", "PART", "SEBS", "INTENTION", "NOMSG", "MSG"]
+        assert [r[0] for r in rows[1:]] == ["1", "2"]
+        assert all(r[4:] == ["", "", ""] for r in rows[1:])     # no zoo model: empty cells
+        assert all(r[1] != "" for r in rows[1:] if suffix != "BLv")
+        extra = list(csv.reader((tmp_path / f"A-{suffix}-extra.csv").open()))
+        assert extra[0] == ["n", "RANDOM", "CYCLIC"]
+    assert (tmp_path / "A.png").stat().st_size > 1000
+    assert "## Map A: MAX" in (tmp_path / "report.md").read_text()

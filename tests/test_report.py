@@ -1,0 +1,47 @@
+"""The table writer on hand-made results."""
+import csv
+
+from patrolsb3.report import evaluation_text, mean_std, write_compare
+
+
+def fake(map_name, n, strategy, max_mean, max_std=0.5):
+    metrics = ("avg_idleness", "max_idleness", "worst_idleness", "std_idleness", "collisions",
+               "battery_failures", "battery_failure_rate", "swap_battery_pct")
+    summary = {m: {"mean": 1.0, "std": 0.0, "tests": [1.0]} for m in metrics}
+    summary["max_idleness"] = {"mean": max_mean, "std": max_std, "tests": [max_mean]}
+    summary["swap_battery_pct"] = {"mean": float("nan"), "std": float("nan"), "tests": []}
+    summary["clean_episodes"] = [4]
+    summary["segments"] = []
+    return {"strategy": strategy, "map": map_name, "n_agents": n, "episodes": 4, "tests": 1,
+            "steps": 10, "summary": summary, "bounds": {"v_over_k": 10.0, "worst": 9.0, "avg": 4.5}}
+
+
+def test_mean_std_format():
+    assert mean_std({"mean": 1.25, "std": 0.5}, 2) == "1.25 +- 0.50"
+    assert mean_std({"mean": float("nan"), "std": 0.0}) == ""
+
+
+def test_write_compare_tables(tmp_path):
+    results = [fake("B", 1, "CR", 12.5), fake("B", 2, "CR", 7.25), fake("B", 2, "SEBS", 6.0),
+               fake("B", 1, "zoo:rl-msg", 3.0), fake("B", 1, "CYCLIC", 9.0)]
+    write_compare(results, tmp_path, plots=False)
+    rows = list(csv.reader((tmp_path / "B-MAX.csv").open()))
+    assert rows == [["n", "CR", "PART", "SEBS", "INTENTION", "NOMSG", "MSG"],
+                    ["1", "12.5", "", "", "", "", "3"],
+                    ["2", "7.25", "", "6", "", "", ""]]
+    assert list(csv.reader((tmp_path / "B-MAX-extra.csv").open())) == [
+        ["n", "RANDOM", "CYCLIC"], ["1", "", "9"], ["2", "", ""]]
+    assert list(csv.reader((tmp_path / "B-BLv.csv").open()))[1] == ["1", "", "", "", "", "", ""]
+    report = (tmp_path / "report.md").read_text()
+    assert "| 1 | 12.5 +- 0.5 |  |  |  |  | 3.0 +- 0.5 |  | 9.0 +- 0.5 |" in report
+    long_rows = list(csv.DictReader((tmp_path / "results.csv").open()))
+    assert len(long_rows) == 5 * 8
+
+
+def test_evaluation_text_lists_every_metric():
+    text = evaluation_text(fake("A", 3, "SEBS", 42.0))
+    for label in ("AVG^h", "MAX^h", "worst idleness", "std across vertices", "collisions / episode",
+                  "battery failures / episode", "battery failure rate", "battery % at swap start",
+                  "|V|/k", "4 of 4"):
+        assert label in text
+    assert "| MAX^h (episodes without battery failure) | 42.00 +- 0.50 |" in text
