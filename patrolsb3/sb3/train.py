@@ -79,15 +79,14 @@ def algorithm_kwargs(hp: dict, spec, layout: dict, phases_per_step: int, rows: i
     """Constructor arguments of the SB3 algorithm from resolved hyperparameters.
 
     ``batch_size`` is ``n_steps * rows / n_minibatches`` unless given; gamma and GAE lambda
-    are converted per env step.
+    are converted per env step; policy_kwargs the algorithm's policy does not take are dropped.
     """
     from .policy import policy_kwargs_for
     n_steps = int(hp["n_steps"])
     batch_size = hp.get("batch_size") or max(1, round(n_steps * rows / int(hp.get("n_minibatches", 1))))
-    policy_kwargs = {k: tuple(v) if isinstance(v, list) else v for k, v in (hp.get("policy_kwargs") or {}).items()}
-    unknown = sorted(set(policy_kwargs) - set(spec.policy_keys))
-    if unknown:
-        raise ValueError(f"policy_kwargs {unknown} do not apply to {spec.name}; known: {sorted(spec.policy_keys)}")
+    # keys of another policy family (e.g. the LSTM sizes for MaskablePPO) are dropped
+    policy_kwargs = {k: tuple(v) if isinstance(v, list) else v for k, v in (hp.get("policy_kwargs") or {}).items()
+                     if k in spec.policy_keys}
     return dict(learning_rate=schedule(hp["learning_rate"]), n_steps=n_steps, batch_size=int(batch_size),
                 n_epochs=int(hp["n_epochs"]), gamma=per_phase(hp["gamma"], phases_per_step),
                 gae_lambda=per_phase(hp["gae_lambda"], phases_per_step), clip_range=float(hp["clip_range"]),

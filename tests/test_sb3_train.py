@@ -1,0 +1,123 @@
+"""train(): run folder, --resume (step count, curriculum, curve), clear errors, algorithms by
+name, and a learning run on a corridor that beats RANDOM."""
+import csv
+
+import numpy as np
+import pytest
+import torch as th
+import yaml
+
+from patrolsb3.core import parse_map
+from patrolsb3.sb3 import make_vec_env
+from patrolsb3.sb3.evaluation import RandomMaskedPolicy, evaluate
+from patrolsb3.sb3.hyperparams import parse_set, per_phase, schedule
+from patrolsb3.sb3.maskable_recurrent_ppo import MaskableRecurrentPPO
+from patrolsb3.sb3.train import curriculum_teams, newest_checkpoint, train
+
+th.set_num_threads(1)
+ROOM = parse_map("S.....\n......\n......\n......", name="room")
+CORRIDOR = parse_map("S.......", name="corridor")
+SMALL_NET = {"dense_sizes": [32, 32], "lstm_hidden_size": 16}
+
+
+def tiny_hp(**extra):
+    hp = {"n_steps": 10, "n_minibatches": 2, "eval_freq": 0, "checkpoint_freq": 400,
+          "env": {"episode_steps": 5}, "policy_kwargs": dict(SMALL_NET)}
+    hp.update(extra)
+    return hp
+
+
+def read_curve(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def test_run_folder_contents(tmp_path):
+    run = train(map=ROOM, timesteps=800, out=tmp_path, hyperparams=tiny_hp(eval_freq=400, eval_episode_steps=3),
+                progress_bar=False)
+    assert run == tmp_path / "room" / "rl-msg" / "MaskableRecurrentPPO_seed0"
+    for name in ("model.zip", "config.yml", "command.txt", "curve.csv", "eval.csv"):
+        assert (run / name).is_file(), name
+    assert any((run / "tb").rglob("events.out.tfevents*"))
+    config = yaml.safe_load((run / "config.yml").read_text())
+    assert config["map"] == "room" and config["map_shape"] == [4, 6] and config["versions"]["env_version"]
+    assert config["hyperparams"]["gamma"] == 0.95 and config["env"]["episode_steps"] == 5
+    eval_rows = read_curve(run / "eval.csv")
+    assert sorted({int(r["n_agents"]) for r in eval_rows}) == [1, 2, 3, 4, 5]
+
+
+def test_resume_continues_steps_curriculum_and_curve(tmp_path):
+    # 40 rows x 10 env steps per rollout = 400 timesteps; episodes of 5 sim steps = 10 env steps.
+    run = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
+    first_rows = len(read_curve(run / "curve.csv"))
+    assert newest_checkpoint(run).name == "model_400_steps.zip"
+    # total 2000: at 400 the progress is 0.2 -> stage 1 (teams 1,1,1,1,2,2,3,3), not stage 0
+    train(map=ROOM, timesteps=2000, out=tmp_path, hyperparams=tiny_hp(), resume=True, progress_bar=False)
+    model = MaskableRecurrentPPO.load(run / "model.zip", device="cpu")
+    assert model.num_timesteps == 2000
+    assert newest_checkpoint(run).name == "model_2000_steps.zip"
+    rows = read_curve(run / "curve.csv")
+    assert len(rows) > first_rows
+    resumed_first = [r for r in rows[first_rows:] if int(r["timesteps"]) == 800]
+    assert {int(r["n_agents"]) for r in resumed_first} == {1, 2, 3}      # stage 1's teams right away
+    assert len((run / "command.txt").read_text().splitlines()) == 2
+
+
+def test_resume_errors(tmp_path):
+    with pytest.raises(FileNotFoundError, match="checkpoints"):
+        train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(), resume=True, progress_bar=False)
+    run = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
+    with pytest.raises(ValueError, match="--resume"):
+        train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
+    other = parse_map("S.....\n......\n......\n.....#", name="room")
+    with pytest.raises(ValueError, match="map_shape|env"):
+        train(map=parse_map("S......\n.......\n.......\n.......", name="room"), timesteps=800, run_dir=run,
+              hyperparams=tiny_hp(), resume=True, progress_bar=False)
+    config = yaml.safe_load((run / "config.yml").read_text())
+    config["versions"]["env_version"] = "patrol_v0"
+    (run / "config.yml").write_text(yaml.safe_dump(config))
+    with pytest.raises(ValueError, match="env version"):
+        train(map=other, timesteps=800, run_dir=run, hyperparams=tiny_hp(), resume=True, progress_bar=False)
+
+
+@pytest.mark.parametrize("kwargs,match", [({"algo": "PPO2"}, "known algorithms"),
+                                          ({"variant": "rl-telepathy"}, "known variants"),
+                                          ({"hyperparams": {"gama": 0.9}}, "unknown hyperparameter")])
+def test_bad_names_list_the_known_ones(tmp_path, kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        train(map=ROOM, timesteps=400, out=tmp_path, progress_bar=False, **kwargs)
+
+
+@pytest.mark.parametrize("algo", ["MaskablePPO", "RecurrentPPO"])
+def test_other_algorithms_by_name(tmp_path, algo):
+    policy_kwargs = SMALL_NET if algo == "RecurrentPPO" else {"dense_sizes": [32, 32]}
+    run = train(map=ROOM, timesteps=400, out=tmp_path, algo=algo, progress_bar=False,
+                hyperparams=tiny_hp(policy_kwargs=policy_kwargs, eval_freq=400, eval_episode_steps=3))
+    assert (run / "model.zip").is_file() and (run / "eval.csv").is_file()
+    assert yaml.safe_load((run / "config.yml").read_text())["algo"] == algo
+
+
+def test_hyperparameter_helpers():
+    assert parse_set(["n_steps=128", "policy_kwargs.lstm_hidden_size=64", "env.episode_steps=10"]) == \
+        {"n_steps": 128, "policy_kwargs": {"lstm_hidden_size": 64}, "env": {"episode_steps": 10}}
+    lr = schedule("drop_2e-4_1e-4")
+    assert lr(1.0) == 2e-4 and lr(0.34) == 2e-4 and lr(0.33) == 1e-4
+    assert schedule("lin_1e-3")(0.5) == pytest.approx(5e-4)
+    with pytest.raises(ValueError, match="lin_"):
+        schedule("cosine")
+    assert per_phase(0.95, 2) ** 2 == pytest.approx(0.95)
+    assert curriculum_teams(2, 5)[-1] == [1, 5] and curriculum_teams(8, 3)[-1] == [1, 1, 1, 1, 2, 3, 3, 3]
+
+
+def test_learns_to_beat_random_on_a_corridor(tmp_path):
+    env_kwargs = {"max_agents": 1, "episode_steps": 30, "p_dyn_max": 0.0}
+    run = train(map=CORRIDOR, variant="rl-no-msg", timesteps=12000, run_dir=tmp_path / "r", seed=0,
+                progress_bar=False,
+                hyperparams={"n_envs": 4, "curriculum": False, "n_steps": 60, "n_minibatches": 4, "n_epochs": 4,
+                             "learning_rate": 1e-3, "eval_freq": 0, "env": env_kwargs,
+                             "policy_kwargs": {"dense_sizes": [64, 64], "lstm_hidden_size": 32}})
+    model = MaskableRecurrentPPO.load(run / "model.zip", device="cpu")
+    env = make_vec_env(CORRIDOR, agents=[1] * 8, variant="rl-no-msg", seed=5, **env_kwargs)
+    trained = np.mean([r["mean_idleness"] for r in evaluate(model, env)])
+    random = np.mean([r["mean_idleness"] for r in evaluate(RandomMaskedPolicy(seed=1), env)])
+    assert trained < 0.8 * random, (trained, random)
