@@ -232,8 +232,6 @@ class PARTPolicy(HeuristicPolicy):
         E, A = sim.pos.shape
         k = sim.n_agents[:, None]                                             # (E, 1)
         slot = np.arange(A)[None, :]
-        own = self.part_cell[k, slot]                                         # (E, A, H*W)
-        inside = (np.take_along_axis(own, sim.pos[..., None], axis=2)[..., 0]
-                  & np.take_along_axis(own, goal[..., None], axis=2)[..., 0])
+        inside = self.part_cell[k, slot, sim.pos] & self.part_cell[k, slot, goal]   # (E, A)
         which = np.where(inside, 1 + k * A + slot, 0)
         return self.nav.toward(sim.pos, goal, mask, tables=self.tables, which=which)
