@@ -79,13 +79,13 @@ class ZooPolicy:
     recurrent state to pass back at the next call.
     """
 
-    def __init__(self, model, spec, cfg: EnvConfig, info: dict):
-        self.model = model
+    def __init__(self, policy, spec, cfg: EnvConfig, info: dict):
+        self.policy = policy
         self.spec = spec
         self.cfg = cfg
         self.info = info
         self.two_phase = cfg.comm != "none" and cfg.message_timing == "same_step"
-        self.recurrent = hasattr(model.policy, "lstm_actor")
+        self.recurrent = hasattr(policy, "lstm_actor")
 
     def _act(self, sim_state, phase: int, lstm, starts):
         message_mask, move_mask = composite_action_mask(self.spec, self.cfg, sim_state,
@@ -94,10 +94,10 @@ class ZooPolicy:
         masks = np.concatenate([message_mask, move_mask], axis=-1).reshape(E * A, -1)
         obs = flat_observation(self.spec, self.cfg, sim_state, phase)
         if self.recurrent:
-            actions, lstm = self.model.predict(obs, state=lstm, episode_start=starts,
+            actions, lstm = self.policy.predict(obs, state=lstm, episode_start=starts,
                                                deterministic=self._deterministic, action_masks=masks)
         else:
-            actions, _ = self.model.predict(obs, deterministic=self._deterministic, action_masks=masks)
+            actions, _ = self.policy.predict(obs, deterministic=self._deterministic, action_masks=masks)
         return np.asarray(actions).reshape(E, A, 2), lstm
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
@@ -169,6 +169,96 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None) -> ZooPolicy:
                for k, v in (config.get("env") or {}).items() if k in env_fields}
     cfg = EnvConfig(**env_cfg)
     from .sb3.algorithms import get_algorithm
-    algo = get_algorithm(config.get("algo", "MaskableRecurrentPPO"))
-    model = algo.load(folder / "model.zip", device="cpu")
-    return ZooPolicy(model, spec, cfg, info)
+    _, policy_class = get_algorithm(config.get("algo", "MaskableRecurrentPPO")).classes()
+    try:
+        policy = policy_class.load(str(folder / "model.zip"), device="cpu")
+    except Exception as exc:  # a corrupt or foreign file: say which one
+        raise ZooError(f"{folder / 'model.zip'}: cannot be loaded as a {policy_class.__name__} "
+                       f"({type(exc).__name__}: {exc})") from exc
+    return ZooPolicy(policy, spec, cfg, info)
+
+
+def export(run_dir, zoo_dir=None, budget: dict | None = None) -> Path:
+    """Copy a finished training run into the zoo, keeping the policy only (no optimizer).
+
+    Args:
+        run_dir: a run folder of ``patrolsb3 train`` (model.zip, config.yml, command.txt,
+            curve.csv, eval.csv).
+        zoo_dir: the zoo root (default: the repository's ``zoo/``).
+        budget: extra facts about the training budget (e.g. cpu_hours), stored in config.yml.
+
+    Returns:
+        The entry folder ``zoo/<map>/<variant>/``.
+
+    Raises:
+        ZooError: the run folder lacks a model or a config.
+    """
+    import datetime
+    import shutil
+    run_dir = Path(run_dir)
+    for name in ("model.zip", "config.yml"):
+        if not (run_dir / name).is_file():
+            raise ZooError(f"{run_dir}: no {name}; not a finished training run")
+    config = yaml.safe_load((run_dir / "config.yml").read_text())
+    from .sb3.algorithms import get_algorithm
+    algo_class, _ = get_algorithm(config["algo"]).classes()
+    model = algo_class.load(str(run_dir / "model.zip"), device="cpu")
+    folder = entry_dir(config["map"], config["variant"], zoo_dir)
+    folder.mkdir(parents=True, exist_ok=True)
+    model.policy.save(str(folder / "model.zip"))
+    for name in ("command.txt", "curve.csv", "eval.csv"):
+        if (run_dir / name).is_file():
+            shutil.copyfile(run_dir / name, folder / name)
+    config["env_version"] = config.get("versions", {}).get("env_version", ENV_VERSION)
+    config["date"] = datetime.date.fromtimestamp((run_dir / "model.zip").stat().st_mtime).isoformat()
+    config["budget"] = {"timesteps": int(model.num_timesteps), **(budget or {})}
+    config["source_run"] = str(run_dir)
+    (folder / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
+    return folder
+
+
+def write_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0, tests: int = 1,
+               progress: bool = True) -> Path:
+    """Evaluate a zoo entry for 1..max_agents agents and write ``eval.json`` beside it.
+
+    Args:
+        folder: the entry folder (``zoo/<map>/<variant>``).
+        episodes: episodes per team size.
+        steps: steps per episode (14,400 = the paper's 24 h).
+        seed: simulator seed (the same for every strategy, so heuristics can be compared).
+        tests: tests per team size.
+        progress: progress bars.
+
+    Returns:
+        Path of eval.json: {"episodes", "steps", "seed", "tests", "results": [{"n_agents",
+        "avg_idleness", "max_idleness", "worst_idleness", "collisions", "battery_failures",
+        "battery_failure_rate", "swap_battery_pct", "clean_episodes"}, ...]}.
+    """
+    from .evaluate import run_episodes, summarize
+    from .core.config import make_config
+    folder = Path(folder)
+    info = read_entry(folder)
+    config = info["config"]
+    zoo_root = folder.parent.parent
+    policy = load(config["map"], config["variant"], zoo_dir=zoo_root)
+    max_agents = policy.cfg.max_agents
+    cfg = make_config(config["map"], max_agents=max_agents, episode_steps=steps)
+    per_size = episodes * tests
+    team = np.repeat(np.arange(1, max_agents + 1), per_size)                # (max_agents * per_size,)
+    per_episode = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, progress=progress,
+                               desc=f"zoo {config['map']}/{config['variant']} n=1..{max_agents}")
+    results = []
+    for n in range(1, max_agents + 1):
+        rows = team == n
+        part = {k: v[rows] for k, v in per_episode.items() if isinstance(v, np.ndarray)}
+        summary = summarize(part, tests)
+        row = {"n_agents": n, "clean_episodes": sum(summary["clean_episodes"])}
+        for key in ("avg_idleness", "max_idleness", "worst_idleness", "std_idleness", "collisions",
+                    "battery_failures", "battery_failure_rate", "swap_battery_pct"):
+            row[key] = summary[key]["mean"]
+        results.append(row)
+    out = {"episodes": episodes, "tests": tests, "steps": steps, "seed": seed,
+           "strategy": f"zoo:{config['variant']}", "map": config["map"], "results": results}
+    path = folder / "eval.json"
+    path.write_text(json.dumps(out, indent=2))
+    return path

@@ -11,6 +11,15 @@ def add_arguments(parser):
     p_show.add_argument("map")
     p_show.add_argument("variant")
     p_show.add_argument("--zoo-dir", default=None)
+    p_export = sub.add_parser("export", help="copy a training run into the zoo (policy only) and "
+                                             "evaluate it for 1..max_agents agents into eval.json")
+    p_export.add_argument("run_dir", help="run folder of 'patrolsb3 train'")
+    p_export.add_argument("--zoo-dir", default=None)
+    p_export.add_argument("--cpu-hours", type=float, default=None, help="training CPU time to record")
+    p_export.add_argument("--episodes", type=int, default=10, help="evaluation episodes per team size")
+    p_export.add_argument("--steps", type=int, default=14400, help="steps per evaluation episode")
+    p_export.add_argument("--seed", type=int, default=0)
+    p_export.add_argument("--no-eval", action="store_true", help="copy only, no eval.json")
 
 
 def headline(entry: dict) -> str:
@@ -25,6 +34,8 @@ def headline(entry: dict) -> str:
 
 def run(args):
     from ..zoo import entry_dir, list_entries, read_entry
+    if args.zoo_command == "export":
+        return export_and_evaluate(args)
     if args.zoo_command == "show":
         print(json.dumps(read_entry(entry_dir(args.map, args.variant, args.zoo_dir)), indent=2, default=str))
         return 0
@@ -39,4 +50,16 @@ def run(args):
               f"env {c.get('env_version', '?')}  trained {c.get('date', '?')}  "
               f"{budget.get('timesteps', '?')} steps, {budget.get('cpu_hours', '?')} CPU h")
         print(f"    {headline(e)}")
+    return 0
+
+
+def export_and_evaluate(args) -> int:
+    """``patrolsb3 zoo export``: copy the run, then write eval.json (paper metrics, n = 1..5)."""
+    from ..zoo import export, write_eval
+    budget = {"cpu_hours": args.cpu_hours} if args.cpu_hours is not None else {}
+    folder = export(args.run_dir, zoo_dir=args.zoo_dir, budget=budget)
+    print(f"exported to {folder}")
+    if not args.no_eval:
+        path = write_eval(folder, episodes=args.episodes, steps=args.steps, seed=args.seed)
+        print(f"evaluation written to {path}")
     return 0
