@@ -1,0 +1,132 @@
+"""The zoo: export of a run (policy only), loading with its checks, acting on the batched state."""
+import json
+import zipfile
+
+import numpy as np
+import pytest
+import torch
+import yaml
+
+from patrolsb3 import zoo
+from patrolsb3.core import load_map, make_config, reset_state
+from patrolsb3.core.masks import composite_action_mask
+from patrolsb3.evaluate import run_episodes
+from patrolsb3.sb3 import make_vec_env
+from patrolsb3.sb3.maskable_recurrent_ppo import MaskableRecurrentPPO
+from patrolsb3.sb3.train import train
+
+torch.set_num_threads(1)
+ROOM_TEXT = "S.....\n......\n..#...\n......\n"
+
+
+@pytest.fixture(scope="module")
+def trained(tmp_path_factory):
+    """A tiny real training run on a 4 x 6 room, exported into a temporary zoo."""
+    root = tmp_path_factory.mktemp("zoo")
+    map_file = root / "room.txt"
+    map_file.write_text(ROOM_TEXT)
+    hp = {"n_steps": 16, "n_minibatches": 2, "n_envs": 2, "eval_freq": 0, "checkpoint_freq": 10**9,
+          "env": {"episode_steps": 20}, "policy_kwargs": {"dense_sizes": [32, 16], "lstm_hidden_size": 8}}
+    run = train(map=str(map_file), variant="rl-msg", timesteps=800, run_dir=root / "run", hyperparams=hp,
+                progress_bar=False)
+    folder = zoo.export(run, zoo_dir=root / "zoo", budget={"cpu_hours": 0.001})
+    return {"root": root, "map_file": map_file, "run": run, "folder": folder}
+
+
+def test_export_keeps_the_policy_only_and_records_the_budget(trained):
+    folder = trained["folder"]
+    assert folder == trained["root"] / "zoo" / "ROOM" / "rl-msg"
+    names = zipfile.ZipFile(folder / "model.zip").namelist()
+    assert not any("optimizer" in n for n in names)
+    run_names = zipfile.ZipFile(trained["run"] / "model.zip").namelist()
+    assert any("optimizer" in n for n in run_names)
+    config = yaml.safe_load((folder / "config.yml").read_text())
+    assert config["env_version"] == "patrol_v1"
+    assert config["budget"]["timesteps"] >= 800 and config["budget"]["cpu_hours"] == 0.001
+    assert (folder / "curve.csv").is_file() and (folder / "command.txt").is_file()
+
+
+def test_flat_observation_is_the_training_layout():
+    vec = make_vec_env(map="B", agents=[3], variant="rl-msg", seed=3)
+    obs = vec.reset()                                                    # (5, D)
+    env = vec.get_env(0)
+    flat = zoo.flat_observation(env.spec_map, env.cfg, env.core_state, phase=0)
+    np.testing.assert_array_equal(flat, obs)
+    actions = np.array([[2, 4], [2, 4], [2, 4], [0, 4], [0, 4]])         # slots 3, 4 absent: silent
+    obs, _, _, _ = vec.step(actions)                                     # message phase -> move phase
+    flat = zoo.flat_observation(env.spec_map, env.cfg, env.core_state, phase=1)
+    np.testing.assert_array_equal(flat, obs)
+    assert flat[0, 2 * 12 * 12 + 6] == 1.0                               # the phase flag
+    assert env.core_state.messages[0, 0] == 3                           # symbol = index + 1
+
+
+def test_zoo_policy_acts_like_the_trained_model(trained):
+    policy = zoo.load("ROOM", "rl-msg", zoo_dir=trained["root"] / "zoo", spec=trained["map_file"])
+    model = MaskableRecurrentPPO.load(str(trained["run"] / "model.zip"), device="cpu")
+    spec = load_map(trained["map_file"])
+    cfg = make_config(None, episode_steps=50)
+    sim = reset_state(spec, cfg, [2, 3], n_envs=2, seed=1)
+    actions, memory = policy.predict(sim, state=None, episode_start=np.ones(2, bool))
+    # the same two phases through the training model
+    E, A = sim.pos.shape
+    silent = sim.copy()
+    silent.messages[:] = 0
+    msg_mask, move_mask = composite_action_mask(spec, policy.cfg, silent, message_phase=True)
+    masks = np.concatenate([msg_mask, move_mask], -1).reshape(E * A, -1)
+    first, state = model.predict(zoo.flat_observation(spec, policy.cfg, silent, 0), state=None,
+                                 episode_start=np.ones(E * A, bool), deterministic=True, action_masks=masks)
+    symbols = np.where(sim.status == 0, first[:, 0].reshape(E, A) + 1, 0)
+    np.testing.assert_array_equal(actions[..., 0], symbols)
+    shown = sim.copy()
+    shown.messages = symbols
+    msg_mask, move_mask = composite_action_mask(spec, policy.cfg, shown, message_phase=False)
+    masks = np.concatenate([msg_mask, move_mask], -1).reshape(E * A, -1)
+    second, _ = model.predict(zoo.flat_observation(spec, policy.cfg, shown, 1), state=state,
+                              episode_start=np.zeros(E * A, bool), deterministic=True, action_masks=masks)
+    np.testing.assert_array_equal(actions[..., 1], second[:, 1].reshape(E, A))
+    assert (actions[..., 1][sim.status != 0] == 4).all()
+
+
+def test_zoo_policy_runs_strict_episodes_and_writes_eval(trained):
+    policy = zoo.load("ROOM", "rl-msg", zoo_dir=trained["root"] / "zoo", spec=trained["map_file"])
+    spec = load_map(trained["map_file"])
+    cfg = make_config(None, episode_steps=60, invalid_action="raise")
+    result = run_episodes(policy, spec, cfg, np.array([1, 2, 3]), 3, seed=0)
+    assert result["avg_idleness"].shape == (3,)
+    assert np.all(result["avg_idleness"] > 0)
+
+
+def test_write_eval_on_every_team_size(trained, monkeypatch):
+    monkeypatch.setattr(zoo, "load", lambda m, v, zoo_dir=None, spec=None, _load=zoo.load:
+                        _load(m, v, zoo_dir=zoo_dir, spec=trained["map_file"]))
+    path = zoo.write_eval(trained["folder"], episodes=2, steps=30, progress=False)
+    data = json.loads(path.read_text())
+    assert [r["n_agents"] for r in data["results"]] == [1, 2, 3, 4, 5]
+    assert data["steps"] == 30 and data["episodes"] == 2
+    assert all(r["avg_idleness"] > 0 for r in data["results"])
+
+
+def test_refusals_name_the_problem(trained, tmp_path):
+    zoo_dir = trained["root"] / "zoo"
+    with pytest.raises(zoo.ZooError, match="unknown variant"):
+        zoo.load("ROOM", "rl-telepathy", zoo_dir=zoo_dir)
+    with pytest.raises(zoo.ZooError, match="the zoo has: ROOM/rl-msg"):
+        zoo.load("A", "rl-msg", zoo_dir=zoo_dir)
+    with pytest.raises(zoo.ZooError, match=r"trained on a \(4, 6\) map"):
+        zoo.load("ROOM", "rl-msg", zoo_dir=zoo_dir, spec="A")
+    # another env version
+    other = tmp_path / "zoo" / "ROOM" / "rl-msg"
+    other.mkdir(parents=True)
+    for name in ("model.zip", "config.yml"):
+        (other / name).write_bytes((trained["folder"] / name).read_bytes())
+    config = yaml.safe_load((other / "config.yml").read_text())
+    config["env_version"] = "patrol_v0"
+    (other / "config.yml").write_text(yaml.safe_dump(config))
+    with pytest.raises(zoo.ZooError, match="env version 'patrol_v0'"):
+        zoo.load("ROOM", "rl-msg", zoo_dir=tmp_path / "zoo", spec=trained["map_file"])
+    # a broken model file
+    config["env_version"] = "patrol_v1"
+    (other / "config.yml").write_text(yaml.safe_dump(config))
+    (other / "model.zip").write_bytes(b"not a zip")
+    with pytest.raises(zoo.ZooError, match="cannot be loaded"):
+        zoo.load("ROOM", "rl-msg", zoo_dir=tmp_path / "zoo", spec=trained["map_file"])
