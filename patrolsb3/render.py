@@ -333,3 +333,58 @@ def plot_idleness_heatmap(spec: MapSpec, mean_idleness_per_vertex, path, title: 
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, bbox_inches="tight")
     return path
+
+
+def read_curve(path) -> dict:
+    """A learning-curve CSV of ``patrolsb3 train`` as columns of float arrays (one row per
+    finished parallel episode)."""
+    import csv
+    with open(path, newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    if not rows:
+        return {}
+    return {key: np.array([float(r[key]) for r in rows]) for key in rows[0]}
+
+
+def trailing_mean(values: np.ndarray, window: int) -> np.ndarray:
+    """Mean of the last ``window`` values at each position (fewer at the start); (N,)."""
+    values = np.asarray(values, dtype=np.float64)
+    csum = np.concatenate([[0.0], np.cumsum(values)])
+    idx = np.arange(1, len(values) + 1)
+    start = np.maximum(idx - window, 0)
+    return (csum[idx] - csum[start]) / (idx - start)
+
+
+def plot_learning_curves(curves: dict, path, title: str = "", window: int = 50) -> Path:
+    """The paper's training figure: episode return (cumulative team reward per episode),
+    smoothed over the last ``window`` episodes, against agent-steps, one line per variant.
+
+    Args:
+        curves: label -> path of a curve.csv.
+        path: PNG to write.
+        title: figure title (e.g. the map).
+        window: episodes in the trailing mean.
+
+    Returns:
+        The PNG path.
+    """
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 3.6), dpi=100)
+    for label, csv_path in curves.items():
+        data = read_curve(csv_path)
+        if not data:
+            continue
+        order = np.argsort(data["timesteps"], kind="stable")
+        ax.plot(data["timesteps"][order], trailing_mean(data["reward"][order], window), label=label)
+    ax.set_xlabel("agent-steps")
+    ax.set_ylabel(f"episode reward (mean of last {window})")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path)
+    plt.close(fig)
+    return path
