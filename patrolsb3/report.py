@@ -77,13 +77,15 @@ def _table_rows(results: list[dict], map_name: str, metric: str, columns) -> lis
     return rows
 
 
-def write_compare(results: list[dict], out_dir, plots: bool = True) -> list[Path]:
+def write_compare(results: list[dict], out_dir, plots: bool = True, learning_curves=None) -> list[Path]:
     """Write every table, the report and the plots of a comparison.
 
     Args:
         results: ``evaluate()`` results (any maps, team sizes and strategies).
         out_dir: output folder (created).
         plots: also draw the PNG plots.
+        learning_curves: map -> {variant: curve.csv path}; draws the paper's training figure
+            (``<MAP>-training.png``) for maps that have any.
 
     Returns:
         The paths written.
@@ -123,6 +125,13 @@ def write_compare(results: list[dict], out_dir, plots: bool = True) -> list[Path
             png = plot_map(results, m, out / f"{m}.png")
             md += [f"![map {m}]({png.name})", ""]
             written.append(png)
+            curves = (learning_curves or {}).get(m)
+            if curves:
+                from .render import plot_learning_curves
+                png = plot_learning_curves(curves, out / f"{m}-training.png", title=f"map {m}: training")
+                md += [f"### Map {m}: learning curves of the zoo models", "",
+                       f"![training on map {m}]({png.name})", ""]
+                written.append(png)
     long_path = out / "results.csv"
     with long_path.open("w", newline="") as fh:
         writer = csv.writer(fh)

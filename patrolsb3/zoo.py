@@ -221,44 +221,60 @@ def write_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0, te
                progress: bool = True) -> Path:
     """Evaluate a zoo entry for 1..max_agents agents and write ``eval.json`` beside it.
 
+    All team sizes run in one batch (episodes x tests per size) so the policy's forward passes
+    are shared; each size's figures are summarised like ``patrolsb3.evaluate.evaluate`` does,
+    so ``patrolsb3 compare`` can reuse them (:func:`cached_result`).
+
     Args:
         folder: the entry folder (``zoo/<map>/<variant>``).
-        episodes: episodes per team size.
+        episodes: episodes per test and team size.
         steps: steps per episode (14,400 = the paper's 24 h).
-        seed: simulator seed (the same for every strategy, so heuristics can be compared).
+        seed: simulator seed.
         tests: tests per team size.
-        progress: progress bars.
+        progress: progress bar.
 
     Returns:
-        Path of eval.json: {"episodes", "steps", "seed", "tests", "results": [{"n_agents",
-        "avg_idleness", "max_idleness", "worst_idleness", "collisions", "battery_failures",
-        "battery_failure_rate", "swap_battery_pct", "clean_episodes"}, ...]}.
+        Path of eval.json: {"map", "strategy", "episodes", "tests", "steps", "seed",
+        "results": [evaluate()-style dict per team size]}.
     """
-    from .evaluate import run_episodes, summarize
     from .core.config import make_config
+    from .core.metrics import idleness_lower_bounds
+    from .evaluate import run_episodes, summarize
     folder = Path(folder)
-    info = read_entry(folder)
-    config = info["config"]
-    zoo_root = folder.parent.parent
-    policy = load(config["map"], config["variant"], zoo_dir=zoo_root)
+    config = read_entry(folder)["config"]
+    policy = load(config["map"], config["variant"], zoo_dir=folder.parent.parent)
     max_agents = policy.cfg.max_agents
-    cfg = make_config(config["map"], max_agents=max_agents, episode_steps=steps)
+    cfg = make_config(config["map"], max_agents=max_agents, episode_steps=steps, invalid_action="raise")
     per_size = episodes * tests
     team = np.repeat(np.arange(1, max_agents + 1), per_size)                # (max_agents * per_size,)
     per_episode = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, progress=progress,
                                desc=f"zoo {config['map']}/{config['variant']} n=1..{max_agents}")
+    strategy = f"zoo:{config['variant']}"
     results = []
     for n in range(1, max_agents + 1):
         rows = team == n
         part = {k: v[rows] for k, v in per_episode.items() if isinstance(v, np.ndarray)}
-        summary = summarize(part, tests)
-        row = {"n_agents": n, "clean_episodes": sum(summary["clean_episodes"])}
-        for key in ("avg_idleness", "max_idleness", "worst_idleness", "std_idleness", "collisions",
-                    "battery_failures", "battery_failure_rate", "swap_battery_pct"):
-            row[key] = summary[key]["mean"]
-        results.append(row)
-    out = {"episodes": episodes, "tests": tests, "steps": steps, "seed": seed,
-           "strategy": f"zoo:{config['variant']}", "map": config["map"], "results": results}
+        results.append({"strategy": strategy, "map": config["map"], "n_agents": n, "episodes": episodes,
+                        "tests": tests, "steps": steps, "seed": seed, "faults": [], "env": cfg.to_dict(),
+                        "summary": summarize(part, tests),
+                        "bounds": idleness_lower_bounds(policy.spec.n_vertices, n, steps)})
+    out = {"map": config["map"], "strategy": strategy, "episodes": episodes, "tests": tests,
+           "steps": steps, "seed": seed, "deterministic": True,
+           "note": "all team sizes stepped in one batch; episodes of size n are rows n-1 of the batch",
+           "results": results}
     path = folder / "eval.json"
     path.write_text(json.dumps(out, indent=2))
     return path
+
+
+def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, steps: int, seed: int,
+                  tests: int = 1, zoo_dir=None):
+    """The entry's eval.json result for exactly this protocol, or None."""
+    path = entry_dir(map_name, variant, zoo_dir) / "eval.json"
+    if not path.is_file():
+        return None
+    data = json.loads(path.read_text())
+    if (data.get("episodes"), data.get("steps"), data.get("seed"), data.get("tests")) != \
+            (episodes, steps, seed, tests):
+        return None
+    return next((r for r in data.get("results", []) if r["n_agents"] == n_agents), None)

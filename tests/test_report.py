@@ -45,3 +45,16 @@ def test_evaluation_text_lists_every_metric():
                   "|V|/k", "4 of 4"):
         assert label in text
     assert "| MAX^h (episodes without battery failure) | 42.00 +- 0.50 |" in text
+
+
+def test_report_draws_the_training_figure_of_zoo_curves(tmp_path):
+    curve = tmp_path / "curve.csv"
+    curve.write_text("timesteps,n_agents,reward\n100,1,-5\n200,2,-3\n")
+    results = [fake("B", 1, "CR", 12.5), fake("B", 2, "CR", 7.25)]
+    written = write_compare(results, tmp_path / "out", plots=True,
+                            learning_curves={"B": {"rl-msg": curve}})
+    assert tmp_path / "out" / "B-training.png" in written
+    assert "![training on map B](B-training.png)" in (tmp_path / "out" / "report.md").read_text()
+    # no curves, no figure
+    write_compare(results, tmp_path / "bare", plots=True)
+    assert not (tmp_path / "bare" / "B-training.png").exists()

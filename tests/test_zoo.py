@@ -103,7 +103,13 @@ def test_write_eval_on_every_team_size(trained, monkeypatch):
     data = json.loads(path.read_text())
     assert [r["n_agents"] for r in data["results"]] == [1, 2, 3, 4, 5]
     assert data["steps"] == 30 and data["episodes"] == 2
-    assert all(r["avg_idleness"] > 0 for r in data["results"])
+    assert all(r["summary"]["avg_idleness"]["mean"] > 0 for r in data["results"])
+    assert data["results"][2]["bounds"]["v_over_k"] == pytest.approx(22 / 3)
+    zoo_dir = trained["root"] / "zoo"
+    hit = zoo.cached_result("ROOM", "rl-msg", 3, episodes=2, steps=30, seed=0, zoo_dir=zoo_dir)
+    assert hit == data["results"][2]
+    assert zoo.cached_result("ROOM", "rl-msg", 3, episodes=2, steps=31, seed=0, zoo_dir=zoo_dir) is None
+    assert zoo.cached_result("ROOM", "rl-no-msg", 3, episodes=2, steps=30, seed=0, zoo_dir=zoo_dir) is None
 
 
 def test_refusals_name_the_problem(trained, tmp_path):

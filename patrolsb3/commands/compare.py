@@ -34,6 +34,9 @@ def add_arguments(parser):
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--no-progress", action="store_true")
+    parser.add_argument("--rerun-zoo", action="store_true",
+                        help="evaluate zoo models again even when their eval.json already holds this "
+                             "exact protocol (episodes, steps, seed, tests)")
 
 
 def run(args):
@@ -59,14 +62,25 @@ def run(args):
                 names += [s for s in ZOO_COLUMNS.values() if zoo.available(m, s.split(":", 1)[1])]
         for name in names:
             for n in sizes:
-                r = evaluate(name, m, n, episodes=args.episodes, tests=args.tests, steps=args.steps,
-                             seed=args.seed, progress=not args.no_progress)
+                r = None
+                if zoo is not None and name.startswith("zoo:") and not args.rerun_zoo:
+                    r = zoo.cached_result(m, name.split(":", 1)[1], n, args.episodes, args.steps,
+                                          args.seed, args.tests)
+                source = "  (from the zoo's eval.json; --rerun-zoo to run it)" if r else ""
+                if r is None:
+                    r = evaluate(name, m, n, episodes=args.episodes, tests=args.tests, steps=args.steps,
+                                 seed=args.seed, progress=not args.no_progress)
                 s = r["summary"]
                 print(f"map {r['map']} {name:>16} n={n}: MAX {s['max_idleness']['mean']:.1f} "
                       f"AVG {s['avg_idleness']['mean']:.1f} col {s['collisions']['mean']:.2f} "
-                      f"BF {s['battery_failure_rate']['mean']:.3f} BLv {s['swap_battery_pct']['mean']:.1f}",
+                      f"BF {s['battery_failure_rate']['mean']:.3f} BLv {s['swap_battery_pct']['mean']:.1f}{source}",
                       flush=True)
                 results.append(r)
-    paths = write_compare(results, args.out)
+    curves = {}
+    if zoo is not None:
+        for m in maps:
+            curves[m.upper()] = {v: p for v in zoo.VARIANT_NAMES
+                                 if (p := zoo.entry_dir(m, v) / "curve.csv").is_file()}
+    paths = write_compare(results, args.out, learning_curves=curves)
     print(f"wrote {len(paths)} files to {args.out} (report: {args.out}/report.md)")
     return 0

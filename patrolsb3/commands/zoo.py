@@ -27,9 +27,13 @@ def headline(entry: dict) -> str:
     ev = entry.get("eval") or {}
     parts = []
     for row in ev.get("results", []):
-        parts.append(f"n={row['n_agents']}: MAX {row['max_idleness']:.0f} AVG {row['avg_idleness']:.0f} "
-                     f"col {row['collisions']:.1f} BF {row['battery_failure_rate']:.2f}")
-    return "; ".join(parts) or "not evaluated"
+        s = row["summary"]
+        parts.append(f"n={row['n_agents']}: MAX {s['max_idleness']['mean']:.0f} "
+                     f"AVG {s['avg_idleness']['mean']:.0f} col {s['collisions']['mean']:.1f} "
+                     f"BF {s['battery_failure_rate']['mean']:.2f}")
+    if not parts:
+        return "not evaluated"
+    return (f"eval {ev['episodes']} episodes x {ev['steps']} steps: " + "; ".join(parts))
 
 
 def run(args):
