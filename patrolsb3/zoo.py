@@ -178,12 +178,14 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None) -> ZooPolicy:
     return ZooPolicy(policy, spec, cfg, info)
 
 
-def export(run_dir, zoo_dir=None, budget: dict | None = None) -> Path:
-    """Copy a finished training run into the zoo, keeping the policy only (no optimizer).
+def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None) -> Path:
+    """Copy a training run into the zoo, keeping the policy only (no optimizer).
 
     Args:
         run_dir: a run folder of ``patrolsb3 train`` (model.zip, config.yml, command.txt,
-            curve.csv, eval.csv).
+            curve.csv, eval.csv). A run stopped before its end has no model.zip: its newest
+            checkpoint is taken (and named in config.yml as ``source_model``).
+        checkpoint: a specific checkpoint file of the run to export instead.
         zoo_dir: the zoo root (default: the repository's ``zoo/``).
         budget: extra facts about the training budget (e.g. cpu_hours), stored in config.yml.
 
@@ -196,13 +198,17 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None) -> Path:
     import datetime
     import shutil
     run_dir = Path(run_dir)
-    for name in ("model.zip", "config.yml"):
-        if not (run_dir / name).is_file():
-            raise ZooError(f"{run_dir}: no {name}; not a finished training run")
+    if not (run_dir / "config.yml").is_file():
+        raise ZooError(f"{run_dir}: no config.yml; not a run folder of 'patrolsb3 train'")
+    from .sb3.train import newest_checkpoint
+    source = Path(checkpoint) if checkpoint else (run_dir / "model.zip" if (run_dir / "model.zip").is_file()
+                                                   else newest_checkpoint(run_dir))
+    if source is None or not source.is_file():
+        raise ZooError(f"{run_dir}: no model.zip and no checkpoint to export")
     config = yaml.safe_load((run_dir / "config.yml").read_text())
     from .sb3.algorithms import get_algorithm
     algo_class, _ = get_algorithm(config["algo"]).classes()
-    model = algo_class.load(str(run_dir / "model.zip"), device="cpu")
+    model = algo_class.load(str(source), device="cpu")
     folder = entry_dir(config["map"], config["variant"], zoo_dir)
     folder.mkdir(parents=True, exist_ok=True)
     model.policy.save(str(folder / "model.zip"))
@@ -210,7 +216,8 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None) -> Path:
         if (run_dir / name).is_file():
             shutil.copyfile(run_dir / name, folder / name)
     config["env_version"] = config.get("versions", {}).get("env_version", ENV_VERSION)
-    config["date"] = datetime.date.fromtimestamp((run_dir / "model.zip").stat().st_mtime).isoformat()
+    config["date"] = datetime.date.fromtimestamp(source.stat().st_mtime).isoformat()
+    config["source_model"] = str(source)
     config["budget"] = {"timesteps": int(model.num_timesteps), **(budget or {})}
     config["source_run"] = str(run_dir)
     (folder / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))

@@ -46,6 +46,20 @@ def test_export_keeps_the_policy_only_and_records_the_budget(trained):
     assert (folder / "curve.csv").is_file() and (folder / "command.txt").is_file()
 
 
+def test_export_of_a_stopped_run_takes_its_newest_checkpoint(trained, tmp_path):
+    import shutil
+    run = tmp_path / "stopped"
+    shutil.copytree(trained["run"], run)
+    (run / "checkpoints").mkdir(exist_ok=True)
+    shutil.move(run / "model.zip", run / "checkpoints" / "model_800_steps.zip")
+    folder = zoo.export(run, zoo_dir=tmp_path / "zoo")
+    config = yaml.safe_load((folder / "config.yml").read_text())
+    assert config["source_model"].endswith("model_800_steps.zip")
+    shutil.rmtree(run / "checkpoints")
+    with pytest.raises(zoo.ZooError, match="no model.zip and no checkpoint"):
+        zoo.export(run, zoo_dir=tmp_path / "zoo")
+
+
 def test_flat_observation_is_the_training_layout():
     vec = make_vec_env(map="B", agents=[3], variant="rl-msg", seed=3)
     obs = vec.reset()                                                    # (5, D)

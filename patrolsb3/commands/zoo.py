@@ -15,6 +15,8 @@ def add_arguments(parser):
                                              "evaluate it for 1..max_agents agents into eval.json")
     p_export.add_argument("run_dir", help="run folder of 'patrolsb3 train'")
     p_export.add_argument("--zoo-dir", default=None)
+    p_export.add_argument("--checkpoint", default=None,
+                          help="checkpoint file to export (default: model.zip, else the newest checkpoint)")
     p_export.add_argument("--cpu-hours", type=float, default=None, help="training CPU time to record")
     p_export.add_argument("--episodes", type=int, default=10, help="evaluation episodes per team size")
     p_export.add_argument("--steps", type=int, default=14400, help="steps per evaluation episode")
@@ -61,7 +63,7 @@ def export_and_evaluate(args) -> int:
     """``patrolsb3 zoo export``: copy the run, then write eval.json (paper metrics, n = 1..5)."""
     from ..zoo import export, write_eval
     budget = {"cpu_hours": args.cpu_hours} if args.cpu_hours is not None else {}
-    folder = export(args.run_dir, zoo_dir=args.zoo_dir, budget=budget)
+    folder = export(args.run_dir, zoo_dir=args.zoo_dir, budget=budget, checkpoint=args.checkpoint)
     print(f"exported to {folder}")
     if not args.no_eval:
         path = write_eval(folder, episodes=args.episodes, steps=args.steps, seed=args.seed)
