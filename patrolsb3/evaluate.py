@@ -178,7 +178,7 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
     max_agents = env.pop("max_agents", 5)
     if not 1 <= n_agents <= max_agents:
         raise ValueError(f"team of {n_agents} agents does not fit: 1 <= agents <= max_agents={max_agents}")
-    cfg = make_config(spec.name if spec.name in "ABCD" else None, max_agents=max_agents,
+    cfg = make_config(spec.name, max_agents=max_agents,
                       episode_steps=steps, faults=tuple(faults), invalid_action="raise", **env)
     policy = load_policy(strategy, spec, n_agents, cfg, seed=seed)
     policy_cfg = getattr(policy, "cfg", None)
