@@ -1,4 +1,4 @@
-"""``patrolsb3 render --map A --agents 3 --steps 300 --out run.gif [--strategy NAME] [--seed S]``:
+"""``patrolsb3 render --map A --agents 3 --steps 300 --out run.gif [--strategy NAME|zoo:VARIANT] [--seed S]``:
 run one episode of a heuristic on the batched core (n_envs = 1) and write it as a GIF."""
 
 
@@ -8,7 +8,7 @@ def add_arguments(parser):
     parser.add_argument("--steps", type=int, default=300, help="simulator steps (default 300)")
     parser.add_argument("--out", default="run.gif", help="output GIF (default run.gif)")
     parser.add_argument("--strategy", default="RANDOM",
-                        help="heuristic: RANDOM, CR, PART, SEBS or CYCLIC (default RANDOM)")
+                        help="RANDOM, CR, PART, SEBS, CYCLIC or a zoo model zoo:<variant> (default RANDOM)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the episode and the strategy")
     parser.add_argument("--fps", type=float, default=10.0, help="frames per second of the GIF")
     parser.add_argument("--every", type=int, default=1, help="keep one frame every N steps")
@@ -21,8 +21,8 @@ def run(args):
 
     from PIL import Image
 
-    from .. import strategies
     from ..core import load_map, make_config, reset_state, step
+    from ..evaluate import load_policy
     from ..render import render_frame, save_gif
 
     if args.steps < 1 or args.every < 1 or args.tile < 4:
@@ -30,7 +30,7 @@ def run(args):
     spec = load_map(args.map)
     cfg = make_config(spec.name, episode_steps=max(5000, args.steps))
     state = reset_state(spec, cfg, args.agents, n_envs=1, seed=args.seed)
-    policy = strategies.get(args.strategy, spec, args.agents, cfg=cfg, seed=args.seed)
+    policy = load_policy(args.strategy, spec, args.agents, cfg, seed=args.seed)
     frames = [render_frame(spec, cfg, state, tile=args.tile)]
     memory, totals = None, {"collisions": 0, "swaps": 0, "failures": 0}
     for t in range(1, args.steps + 1):
