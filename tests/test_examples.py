@@ -1,0 +1,16 @@
+"""The example scripts run for real (tiny budgets), as a user would start them."""
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def test_train_map_a_example_trains_and_writes_a_run_folder(tmp_path):
+    proc = subprocess.run([sys.executable, str(ROOT / "examples" / "train_map_a.py"), "--timesteps", "1000",
+                           "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    run = tmp_path / "A" / "rl-msg" / "MaskableRecurrentPPO_seed0"
+    for name in ("model.zip", "config.yml", "command.txt"):
+        assert (run / name).is_file(), name
+    assert "examples/train_map_a.py" in (run / "command.txt").read_text()
