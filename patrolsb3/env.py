@@ -28,8 +28,8 @@ class PatrolParallelEnv(ParallelEnv):
     Observation (``Dict``), per agent:
         * ``grid``: Box(-1, 1, (2, H, W), float32): channel 0 positions and messages, channel 1
           normalised idleness (see :mod:`patrolsb3.core.observe`).
-        * ``vector``: Box(-1, 1, (8,), float32): battery fraction, own move mask (5), phase
-          (0 message, 1 move), active flag.
+        * ``vector``: Box(-1, 1, (15,), float32): battery fraction, own move mask (5), phase
+          (0 message, 1 move), active flag, home distance, battery margin, home direction (5).
         * ``critic``: Box(0, 1, (3 * max_agents,), float32): every slot's battery fraction and
           position (centralised critic state; a policy's actor must not read it).
 

@@ -32,10 +32,10 @@ class ZooError(ValueError):
 
 
 def flat_observation(spec, cfg: EnvConfig, state, phase: int) -> np.ndarray:
-    """Observations in the training layout [grid (2*H*W), vector (8), critic (3*A)].
+    """Observations in the training layout [grid (2*H*W), vector (15), critic (3*A)].
 
     Returns:
-        (E * A, 2*H*W + 8 + 3*A) float32, row e * A + i = slot i of episode e.
+        (E * A, 2*H*W + 15 + 3*A) float32, row e * A + i = slot i of episode e.
     """
     grid, vector = actor_observation(spec, cfg, state, phase=phase)        # (E,A,2,H,W), (E,A,8)
     E, A = state.pos.shape

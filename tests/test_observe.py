@@ -72,9 +72,14 @@ def test_vector(observed):
     spec, cfg, state = observed
     _, vector = actor_observation(spec, cfg, state, phase=0)
     assert vector.shape == (1, 3, VECTOR_SIZE)
-    assert list(vector[0, 0]) == [0.5, 1, 1, 1, 1, 1, 0, 1]     # (1, 4): every move free
-    assert list(vector[0, 1]) == [1.0, 1, 0, 1, 0, 1, 0, 1]     # (2, 6): Down, Right leave the grid
-    assert list(vector[0, 2]) == [1.0, 0, 0, 0, 0, 1, 0, 0]     # absent: Stay only, inactive
+    assert list(vector[0, 0, :8]) == [0.5, 1, 1, 1, 1, 1, 0, 1]     # (1, 4): every move free
+    assert list(vector[0, 1, :8]) == [1.0, 1, 0, 1, 0, 1, 0, 1]     # (2, 6): Down, Right leave the grid
+    assert list(vector[0, 2, :8]) == [1.0, 0, 0, 0, 0, 1, 0, 0]     # absent: Stay only, inactive
+    # home features: (1, 4) is 5 steps from the station, first move Left; (2, 6) is 8 steps,
+    # Up and Left tie and the lower action index (Up) wins; H + W = 10
+    np.testing.assert_allclose(vector[0, 0, 8:], [0.5, 0.5 - 5 * cfg.drain[1] / 550, 0, 0, 1, 0, 0], rtol=1e-6)
+    np.testing.assert_allclose(vector[0, 1, 8:], [0.8, 1.0 - 8 * cfg.drain[1] / 550, 1, 0, 0, 0, 0], rtol=1e-6)
+    assert not vector[0, 2, 8:].any()
     _, vector = actor_observation(spec, cfg, state, phase=1)
     assert vector[0, 0, 6] == 1
 

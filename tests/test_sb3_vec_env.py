@@ -10,6 +10,7 @@ from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
 from patrolsb3.core import parse_map
 from patrolsb3.core.maps import STAY
+from patrolsb3.core.observe import VECTOR_SIZE
 from patrolsb3.env import PatrolParallelEnv
 from patrolsb3.sb3 import VARIANTS, make_vec_env
 from patrolsb3.sb3.vec_env import PatrolVecEnv, flatten_observation
@@ -20,7 +21,7 @@ torch.set_num_threads(1)
 
 A = 5                  # default max_agents
 H, W = 3, 7            # NON_SQUARE map: axis mix-ups show up
-OBS_SIZE = 2 * H * W + 8 + 3 * A
+OBS_SIZE = 2 * H * W + VECTOR_SIZE + 3 * A
 TEAMS = [1, 2, 5]
 
 
@@ -50,7 +51,7 @@ def test_spaces_and_layout(spec):
     assert venv.observation_space.shape == (OBS_SIZE,)
     assert venv.observation_space.dtype == np.float32
     assert list(venv.action_space.nvec) == [16, 5]
-    assert venv.layout == {"grid_shape": (2, H, W), "vector_size": 8, "critic_size": 3 * A}
+    assert venv.layout == {"grid_shape": (2, H, W), "vector_size": VECTOR_SIZE, "critic_size": 3 * A}
     obs = venv.reset()
     assert obs.shape == (venv.num_envs, OBS_SIZE) and obs.dtype == np.float32
     assert venv.observation_space.contains(obs[0])

@@ -12,7 +12,18 @@ Grid channel 0 (positions and messages), values divided by ``n_symbols + 2``:
 Grid channel 1 (idleness): f(i) = 1 - exp(-i / c_norm) on vertices (1 if never visited),
 -1 on obstacles, 0 on stations.
 
-Vector: [own battery fraction, own move mask (5), phase (0 message, 1 move), active flag].
+Vector: [own battery fraction, own move mask (5), phase (0 message, 1 move), active flag,
+home distance, battery margin, home direction (5)]:
+
+* home distance = shortest-path steps to the nearest station / (H + W);
+* battery margin = battery fraction - steps home x the largest drain / b_max (clipped to
+  [-1, 1]): about 0 when the battery would only just bring the agent home;
+* home direction = one-hot of the first move of a shortest path to the nearest station
+  (Stay on a station).
+
+The last three are OURS, not the paper's (its actor sees the graph and its battery only): a
+compass to the station, so that the recharge decision is learnable within a CPU budget. Every
+learned variant gets them alike. They are 0 for inactive slots.
 
 Critic state: for every slot its battery fraction, row / (H-1) and col / (W-1); an absent
 or failed slot is padded with battery 1 and the station's position (the paper's padding).
@@ -27,8 +38,29 @@ from .masks import action_mask
 from .reward import normalised_idleness
 from .state import ACTIVE, State
 
-VECTOR_SIZE = 8
+VECTOR_SIZE = 15
 """Length of the actor's vector observation."""
+
+
+def home_features(spec: MapSpec, cfg: EnvConfig, state: State) -> np.ndarray:
+    """Home distance, battery margin and home direction of every slot (see module docstring).
+
+    Returns:
+        (E, A, 7) float32, zeros for inactive slots.
+    """
+    H, W = spec.shape
+    here = spec.free_index[state.pos]                                         # (E, A)
+    station_free = spec.free_index[spec.stations]                             # (S,)
+    to_station = spec.dist[here][..., station_free]                           # (E, A, S)
+    nearest = np.argmin(to_station, axis=-1)                                  # (E, A)
+    steps_home = np.take_along_axis(to_station, nearest[..., None], axis=-1)[..., 0]
+    first = spec.next_action[here, station_free[nearest]]                     # (E, A)
+    out = np.zeros(state.pos.shape + (7,), dtype=np.float32)
+    out[..., 0] = steps_home / (H + W)
+    out[..., 1] = np.clip((state.battery - steps_home * cfg.drain[1]) / cfg.b_max, -1.0, 1.0)
+    np.put_along_axis(out[..., 2:], first[..., None].astype(np.int64), 1.0, axis=-1)
+    out[~state.active] = 0.0
+    return out
 
 
 def grid_size(spec: MapSpec) -> int:
@@ -81,6 +113,7 @@ def actor_observation(spec: MapSpec, cfg: EnvConfig, state: State, phase: int = 
     vector[..., 1:6] = mask
     vector[..., 6] = phase
     vector[..., 7] = active
+    vector[..., 8:] = home_features(spec, cfg, state)
     return grid.reshape(E, A, 2, H, W), vector
 
 

@@ -1,7 +1,7 @@
 """The paper's actor and critic networks as SB3 policies (SPEC.md section 7).
 
 Observation rows of :func:`patrolsb3.sb3.make_vec_env` are flat vectors
-``[grid (2, H, W) flattened, vector (8), critic (3 * max_agents)]``. Each network is
+``[grid (2, H, W) flattened, vector (15), critic (3 * max_agents)]``. Each network is
 
     Conv(2->4, 3x3) tanh -> Conv(4->8, 3x3) tanh -> flatten (8 x (H-4) x (W-4))
     -> concat vector (actor) or vector + critic state (critic)

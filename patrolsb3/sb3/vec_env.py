@@ -78,11 +78,11 @@ def flatten_observation(obs: dict) -> np.ndarray:
     """Flatten Dict observations to the vector layout [grid, vector, critic].
 
     Args:
-        obs: {"grid": (..., 2, H, W), "vector": (..., 8), "critic": (..., 3 * max_agents)},
+        obs: {"grid": (..., 2, H, W), "vector": (..., 15), "critic": (..., 3 * max_agents)},
             with any number of leading batch axes (none for one agent's observation).
 
     Returns:
-        (..., 2*H*W + 8 + 3*max_agents) float32.
+        (..., 2*H*W + 15 + 3*max_agents) float32.
     """
     batch = obs["vector"].shape[:-1]
     return np.concatenate([obs["grid"].reshape(*batch, -1), obs["vector"], obs["critic"]],
@@ -100,8 +100,8 @@ class PatrolVecEnv(VecEnvWrapper):
     Row ``k`` is slot ``k % max_agents`` of episode ``k // max_agents``; one shared policy
     acts for all rows (parameter sharing).
 
-    Observation: Box(-1, 1, (2*H*W + 8 + 3*max_agents,), float32), the env's Dict observation
-    flattened as [grid (2, H, W) in C order, vector (8), critic (3*max_agents)]; see
+    Observation: Box(-1, 1, (2*H*W + 15 + 3*max_agents,), float32), the env's Dict observation
+    flattened as [grid (2, H, W) in C order, vector (15), critic (3*max_agents)]; see
     :attr:`layout`. The critic part is the centralised state; actors must not read it.
 
     Action: MultiDiscrete([n_symbols, 5]) = (message, move). :meth:`action_masks` gives
@@ -112,7 +112,7 @@ class PatrolVecEnv(VecEnvWrapper):
     slot's return, "l": env steps}) and ``team_episode`` (see :meth:`_team_summary`).
 
     Attributes:
-        layout: {"grid_shape": (2, H, W), "vector_size": 8, "critic_size": 3 * max_agents}.
+        layout: {"grid_shape": (2, H, W), "vector_size": 15, "critic_size": 3 * max_agents}.
         phases_per_step: env steps per simulator step (2 with same-step messages, else 1);
             discount per env step = gamma ** (1 / phases_per_step), gamma per simulator step.
         max_agents: slots per parallel episode.
