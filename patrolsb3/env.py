@@ -79,7 +79,7 @@ class PatrolParallelEnv(ParallelEnv):
         self._seed = seed
         self.core_state = None
         self.phase = MOVE_PHASE
-        self._two_phase = self.cfg.comm != "none" and self.cfg.message_timing == "same_step"
+        self._two_phase = self.cfg.two_phase
         H, W = self.spec_map.shape
         A = self.cfg.max_agents
         self._obs_space = spaces.Dict({

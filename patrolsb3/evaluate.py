@@ -52,6 +52,15 @@ def parse_faults(texts) -> tuple:
     return tuple(sorted(faults))
 
 
+def canonical_name(name: str) -> str:
+    """The name tables use: heuristics in capitals ('sebs' -> 'SEBS'), zoo models as
+    'zoo:<variant>' in lower case."""
+    name = str(name).strip()
+    if name.lower().startswith("zoo:"):
+        return "zoo:" + name.split(":", 1)[1].lower()
+    return name.upper()
+
+
 def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0):
     """A heuristic by name, or ``zoo:<variant>`` through ``patrolsb3.zoo.load(map, variant)``.
 
@@ -173,6 +182,11 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
         ``bounds`` (:func:`idleness_lower_bounds`).
     """
     spec = load_map(map_name)
+    name = canonical_name(strategy)
+    late = [f for f in faults if f[0] >= steps]
+    if late:
+        raise ValueError(f"--faults {late[0][0]}:{late[0][1]} is outside the episode: STEP must be "
+                         f"< --steps ({steps})")
     if episodes < 1 or tests < 1 or steps < 1:
         raise ValueError(f"episodes, tests and steps must be >= 1 (got {episodes}, {tests}, {steps})")
     max_agents = env.pop("max_agents", 5)
@@ -186,7 +200,7 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
         cfg = make_config(None, **{**cfg.to_dict(), "max_agents": policy_cfg.max_agents})
     per_episode = run_episodes(policy, spec, cfg, n_agents, tests * episodes, seed=seed,
                                progress=progress, desc=f"{strategy} map {spec.name} n={n_agents}")
-    return {"strategy": str(strategy), "map": spec.name, "n_agents": int(n_agents),
+    return {"strategy": name, "map": spec.name, "n_agents": int(n_agents),
             "episodes": int(episodes), "tests": int(tests), "steps": int(steps), "seed": int(seed),
             "faults": [list(f) for f in faults], "env": cfg.to_dict(),
             "summary": summarize(per_episode, tests),

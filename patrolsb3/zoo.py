@@ -84,7 +84,7 @@ class ZooPolicy:
         self.spec = spec
         self.cfg = cfg
         self.info = info
-        self.two_phase = cfg.comm != "none" and cfg.message_timing == "same_step"
+        self.two_phase = cfg.two_phase
         self.recurrent = hasattr(policy, "lstm_actor")
 
     def _act(self, sim_state, phase: int, lstm, starts):
@@ -175,6 +175,12 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None) -> ZooPolicy:
     except Exception as exc:  # a corrupt or foreign file: say which one
         raise ZooError(f"{folder / 'model.zip'}: cannot be loaded as a {policy_class.__name__} "
                        f"({type(exc).__name__}: {exc})") from exc
+    from .core.observe import VECTOR_SIZE
+    expected = (2 * spec.kinds.size + VECTOR_SIZE + 3 * cfg.max_agents,)
+    if tuple(policy.observation_space.shape) != expected:
+        raise ZooError(f"{folder / 'model.zip'}: the policy reads observations of shape "
+                       f"{tuple(policy.observation_space.shape)}, this code makes {expected} "
+                       f"(a checkpoint of another observation layout); retrain it")
     return ZooPolicy(policy, spec, cfg, info)
 
 

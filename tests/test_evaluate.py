@@ -90,7 +90,7 @@ def test_cli_evaluate_writes_json(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "MAX^h" in text and "battery failure rate" in text and "|V|/k" in text
     result = json.loads(out.read_text())
-    assert result["strategy"] == "cr" and result["summary"]["clean_episodes"] == [2]
+    assert result["strategy"] == "CR" and result["summary"]["clean_episodes"] == [2]
     assert cli.main(["evaluate", "--strategy", "nope", "--episodes", "1", "--steps", "2"]) == 2
     assert cli.main(["evaluate", "--strategy", "CR", "--agents", "7", "--episodes", "1",
                      "--steps", "2"]) == 2
@@ -110,3 +110,19 @@ def test_cli_compare_writes_paper_tables(tmp_path):
         assert extra[0] == ["n", "RANDOM", "CYCLIC"]
     assert (tmp_path / "A.png").stat().st_size > 1000
     assert "## Map A: MAX" in (tmp_path / "report.md").read_text()
+
+
+def test_faults_outside_the_episode_are_refused():
+    with pytest.raises(ValueError, match="outside the episode"):
+        evaluate("CR", "A", 2, episodes=1, steps=100, faults=((100, 1),), progress=False)
+
+
+def test_compare_refuses_bad_strategies_before_running(tmp_path):
+    assert cli.main(["compare", "--maps", "A", "--agents", "1", "--episodes", "1", "--steps", "5",
+                     "--strategies", "CR,NOPE", "--out", str(tmp_path / "o")]) == 2
+    assert not (tmp_path / "o").exists()
+    assert cli.main(["compare", "--maps", "A", "--agents", "1", "--episodes", "1", "--steps", "5",
+                     "--strategies", "cr,sebs", "--out", str(tmp_path / "p"), "--no-progress"]) == 0
+    rows = (tmp_path / "p" / "A-MAX.csv").read_text().splitlines()
+    cells = rows[1].split(",")
+    assert cells[1] != "" and cells[3] != ""          # CR and SEBS columns filled from lower-case names

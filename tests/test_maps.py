@@ -160,3 +160,11 @@ def test_load_map_from_a_file(tmp_path):
     assert spec.name == "mine"
     assert spec.source == str(path)
     assert spec.shape == (3, 7)
+
+
+def test_a_shipped_map_loaded_by_path_keeps_its_letter_and_paper_values():
+    from patrolsb3.core import make_config
+    from patrolsb3.core.maps import MAPS_DIR
+    spec = load_map(str(MAPS_DIR / "map_b.txt"))
+    assert spec.name == "B"
+    assert make_config(spec.name).c_pbb == 0.5

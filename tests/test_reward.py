@@ -136,3 +136,16 @@ def test_inactive_slot_reward_is_zero(line_map):
     info = step(spec, cfg, state, np.array([[STAY, STAY, STAY]]))
     assert list(info.reward[0, 1:]) == [0.0, 0.0]
     assert info.reward[0, 0] != 0.0
+
+
+def test_an_agent_saved_by_its_arrival_gets_the_low_battery_penalty_not_the_failure_one():
+    from patrolsb3.core import parse_map, reset_state, step
+    from patrolsb3.core.config import make_config
+    spec = parse_map("S..")
+    cfg = make_config(None, max_agents=1, p_dyn_max=0.0, drain=(1.0, 1.0))
+    state = reset_state(spec, cfg, 1, seed=0)
+    state.pos[0, 0] = 1                                   # next to the station
+    state.battery[0, 0] = 0.5                             # runs out during the move home
+    info = step(spec, cfg, state, [[2]])                  # Left, onto the station
+    assert info.swap_started[0, 0] and not info.battery_failed[0, 0]
+    assert info.reward_battery[0, 0] == pytest.approx(-(cfg.c_pbb + cfg.c_pbm), rel=1e-6)

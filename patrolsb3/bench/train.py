@@ -2,7 +2,8 @@
 A, 8 parallel episodes at the last curriculum stage 1,1,1,1,2,3,4,5, paper network).
 
 ``agent_steps_per_s`` counts vec-env rows (8 episodes x 5 slots) x env steps, as SB3's
-``num_timesteps`` does. The wall time of a short ``learn()`` is split into ``env_s`` (inside
+``num_timesteps`` does; ``deployed_agent_sim_steps_per_s`` is the same time counted in
+simulator steps of deployed agents only (19 of the 40 rows, one of the two phases). The wall time of a short ``learn()`` is split into ``env_s`` (inside
 ``env.step``), ``forward_s`` (policy forward passes during collection) and ``update_s``
 (``train()``: the PPO epochs); the rest (masks, buffer, callbacks) is ``other_s``.
 """
@@ -63,6 +64,9 @@ def measure(n_rollouts: int = 2, n_steps: int | None = None, seed: int = 0, over
     out["total_s"] = round(total, 3)
     out["agent_steps"] = int(model.num_timesteps)
     out["agent_steps_per_s"] = model.num_timesteps / total
+    # the same time in simulator steps of deployed agents (no padded slots, no message phases)
+    deployed = sum(DEFAULT_AGENTS) / rows
+    out["deployed_agent_sim_steps_per_s"] = round(out["agent_steps_per_s"] * deployed / vec_env.phases_per_step)
     out["batch_size"] = int(model.batch_size)
     out["n_steps"] = int(model.n_steps)
     return out

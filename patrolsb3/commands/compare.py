@@ -52,10 +52,25 @@ def run(args):
         zoo = importlib.import_module("patrolsb3.zoo")
     except ImportError:
         zoo = None
+    from ..core.maps import load_map
+    from ..evaluate import canonical_name
+    from ..strategies import REGISTRY
+    for m in maps:                                            # fail now, not after an hour
+        load_map(m)
+    if max(sizes) > 5:
+        raise ValueError(f"--agents {args.agents}: at most 5 agents (max_agents) per team")
+    for name in (args.strategies or "").split(","):
+        name = canonical_name(name) if name.strip() else ""
+        if name and not name.startswith("zoo:") and name not in REGISTRY:
+            raise ValueError(f"unknown strategy {name!r}; known: {', '.join(REGISTRY)} or zoo:<variant>")
+        if name.startswith("zoo:"):
+            missing = [m for m in maps if zoo is None or not zoo.available(m, name.split(":", 1)[1])]
+            if missing:
+                raise ValueError(f"{name}: no zoo model for map(s) {', '.join(missing)}")
     results = []
     for m in maps:
         if args.strategies:
-            names = [s.strip() for s in args.strategies.split(",") if s.strip()]
+            names = [canonical_name(s) for s in args.strategies.split(",") if s.strip()]
         else:
             names = ["CR", "PART", "SEBS", *EXTRA_COLUMNS]
             if zoo is not None:

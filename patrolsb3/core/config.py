@@ -97,6 +97,11 @@ class EnvConfig:
         object.__setattr__(self, "faults", tuple(tuple(int(v) for v in f) for f in self.faults))
 
     @property
+    def two_phase(self) -> bool:
+        """True when a message phase precedes each move phase (same-step messages)."""
+        return self.comm != "none" and self.message_timing == "same_step"
+
+    @property
     def b_low(self) -> float:
         """b_l in battery units."""
         return self.b_low_frac * self.b_max

@@ -269,7 +269,9 @@ def load_map(name_or_path) -> MapSpec:
     if path.suffix == ".txt" or path.exists() or "/" in text_name:
         if not path.is_file():
             raise MapError(f"{text_name}: map file not found")
-        return parse_map(path.read_text(), name=path.stem, source=str(path))
+        shipped = path.resolve().parent == MAPS_DIR and path.stem.startswith("map_")
+        name = path.stem[4:].upper() if shipped else path.stem
+        return parse_map(path.read_text(), name=name, source=str(path))
     candidate = MAPS_DIR / f"map_{text_name.lower()}.txt"
     if not candidate.is_file():
         raise MapError(f"unknown map {text_name!r}; known maps: {', '.join(available_maps())} "

@@ -15,7 +15,7 @@ Grid channel 1 (idleness): f(i) = 1 - exp(-i / c_norm) on vertices (1 if never v
 Vector: [own battery fraction, own move mask (5), phase (0 message, 1 move), active flag,
 home distance, battery margin, home direction (5)]:
 
-* home distance = shortest-path steps to the nearest station / (H + W);
+* home distance = shortest-path steps to the nearest station / (H + W), at most 1;
 * battery margin = battery fraction - steps home x the largest drain / b_max (clipped to
   [-1, 1]): about 0 when the battery would only just bring the agent home;
 * home direction = one-hot of the first move of a shortest path to the nearest station
@@ -56,7 +56,7 @@ def home_features(spec: MapSpec, cfg: EnvConfig, state: State) -> np.ndarray:
     steps_home = np.take_along_axis(to_station, nearest[..., None], axis=-1)[..., 0]
     first = spec.next_action[here, station_free[nearest]]                     # (E, A)
     out = np.zeros(state.pos.shape + (7,), dtype=np.float32)
-    out[..., 0] = steps_home / (H + W)
+    out[..., 0] = np.minimum(steps_home / (H + W), 1.0)
     out[..., 1] = np.clip((state.battery - steps_home * cfg.drain[1]) / cfg.b_max, -1.0, 1.0)
     np.put_along_axis(out[..., 2:], first[..., None].astype(np.int64), 1.0, axis=-1)
     out[~state.active] = 0.0

@@ -208,14 +208,16 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
     battery_failed = acted & ~arrived & (state.battery <= 0)
     state.status = np.where(battery_failed, FAILED, state.status).astype(np.int8)
     fault_failed = _inject_faults(cfg, state, rng)
-    reward_battery = battery_reward(state.battery, cfg) if compute_reward else None
+    # an agent saved by its arrival on the station did not fail: it gets the low-battery penalty
+    reward_battery = (battery_reward(np.where(arrived, np.maximum(state.battery, 1e-9), state.battery), cfg)
+                      if compute_reward else None)
     state.battery = np.maximum(state.battery, 0.0)
     state.t += 1
     # rewards
     if compute_reward:
         f = normalised_idleness(state.idle, state.visited, cfg.c_norm)       # (E, V)
         team, mean_f, max_f = team_patrol_reward(f)
-        f_without_k = np.where(visited_without_k, -np.expm1(-idle_without_k / cfg.c_norm), 1.0)
+        f_without_k = normalised_idleness(idle_without_k, visited_without_k, cfg.c_norm)
         d = difference_reward(f_without_k, on_vertex, mean_f, max_f, spec.n_vertices)
         reward_patrol = np.where(acted, cfg.c_rp * team[:, None] + cfg.difference_weight * d, 0.0)
         reward_battery = np.where(acted, reward_battery, 0.0)

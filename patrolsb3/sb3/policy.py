@@ -129,7 +129,7 @@ class PatrolRecurrentPolicy(_RoleExtractorMixin, RecurrentActorCriticPolicy):
         **kwargs: passed to :class:`RecurrentActorCriticPolicy`.
     """
 
-    def __init__(self, observation_space, action_space, lr_schedule, grid_shape, vector_size: int = 8,
+    def __init__(self, observation_space, action_space, lr_schedule, grid_shape, vector_size: int = 15,
                  critic_size: int = 15, conv_channels=(4, 8), dense_sizes=(512, 341, 227),
                  lstm_hidden_size: int = 128, enable_critic_lstm: bool = False, **kwargs: Any):
         kwargs.setdefault("activation_fn", nn.Tanh)
@@ -260,7 +260,7 @@ class PatrolMaskablePolicy(_RoleExtractorMixin, MaskableActorCriticPolicy):
         **kwargs: passed to :class:`MaskableActorCriticPolicy`.
     """
 
-    def __init__(self, observation_space, action_space, lr_schedule, grid_shape, vector_size: int = 8,
+    def __init__(self, observation_space, action_space, lr_schedule, grid_shape, vector_size: int = 15,
                  critic_size: int = 15, conv_channels=(4, 8), dense_sizes=(512, 341, 227), **kwargs: Any):
         kwargs.setdefault("activation_fn", nn.Tanh)
         kwargs.setdefault("net_arch", dict(pi=[], vf=[]))
