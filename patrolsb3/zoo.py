@@ -168,6 +168,8 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None) -> ZooPolicy:
     env_cfg = {k: (tuple(v) if isinstance(v, list) else v)
                for k, v in (config.get("env") or {}).items() if k in env_fields}
     cfg = EnvConfig(**env_cfg)
+    import torch
+    torch.set_num_threads(1)     # small networks: one thread is fastest, and several oversubscribe
     from .sb3.algorithms import get_algorithm
     _, policy_class = get_algorithm(config.get("algo", "MaskableRecurrentPPO")).classes()
     try:
