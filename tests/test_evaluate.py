@@ -126,3 +126,14 @@ def test_compare_refuses_bad_strategies_before_running(tmp_path):
     rows = (tmp_path / "p" / "A-MAX.csv").read_text().splitlines()
     cells = rows[1].split(",")
     assert cells[1] != "" and cells[3] != ""          # CR and SEBS columns filled from lower-case names
+
+
+def test_summary_also_averages_over_every_episode():
+    per_episode = {"failed": np.array([True, False, False, True]),
+                   "battery_failures": np.array([1, 0, 0, 2]), "swaps": np.array([0, 1, 1, 0]),
+                   "swap_battery": np.array([np.nan, 0.2, 0.3, np.nan])}
+    for name in ("avg_idleness", "max_idleness", "worst_idleness", "std_idleness", "collisions"):
+        per_episode[name] = np.array([10.0, 2.0, 4.0, 20.0])
+    s = summarize(per_episode, tests=2)
+    assert s["avg_idleness"]["tests"] == [2.0, 4.0]              # clean episodes only
+    assert s["avg_idleness_all"]["tests"] == [6.0, 12.0]         # every episode
