@@ -138,7 +138,8 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
         writer.writerow(["map", "n", "strategy", "metric", "mean", "std", "clean_episodes",
                          "episodes", "tests", "steps"])
         for r in results:
-            for metric in LABELS:
+            metrics = [m for m, v in r["summary"].items() if isinstance(v, dict) and "mean" in v]
+            for metric in metrics:                 # LABELS' metrics and their *_all twins
                 s = r["summary"][metric]
                 writer.writerow([r["map"], r["n_agents"], r["strategy"], metric, s["mean"], s["std"],
                                  sum(r["summary"]["clean_episodes"]), r["episodes"] * r["tests"],
