@@ -178,3 +178,36 @@ def plot_map(results: list[dict], map_name: str, path) -> Path:
     fig.savefig(path, dpi=80)
     plt.close(fig)
     return Path(path)
+
+
+ZOO_TABLE_METRICS = (("avg_idleness_all", "AVG^h (all)", 1), ("max_idleness_all", "MAX^h (all)", 1),
+                     ("avg_idleness", "AVG^h (no BF)", 1), ("max_idleness", "MAX^h (no BF)", 1),
+                     ("collisions_all", "collisions", 1), ("battery_failure_rate", "BF rate", 2),
+                     ("battery_failures", "failures / ep", 2), ("swap_battery_pct", "battery % at swap", 1))
+"""Columns of the zoo README's tables: (metric, header, digits)."""
+
+
+def zoo_tables(results_csv, strategies=("zoo:rl-msg", "zoo:rl-no-msg", "zoo:rl-intention", "CR", "PART",
+                                        "SEBS", "CYCLIC")) -> str:
+    """Markdown tables, one per map, of zoo models against the heuristics, read from a
+    comparison's ``results.csv``: rows (n, strategy), columns :data:`ZOO_TABLE_METRICS`.
+    "(all)" averages over every episode, "(no BF)" over episodes without a battery failure
+    (the paper's convention; empty when every episode had one)."""
+    with open(results_csv, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    value = {(r["map"], int(r["n"]), r["strategy"], r["metric"]): float(r["mean"]) for r in rows}
+    out = []
+    for m in sorted({r["map"] for r in rows}):
+        present = [s for s in strategies if any(k[0] == m and k[2] == s for k in value)]
+        ns = sorted({k[1] for k in value if k[0] == m})
+        out += [f"### Map {m}", "", "| n | strategy | " + " | ".join(h for _, h, _ in ZOO_TABLE_METRICS) + " |",
+                "|---" * (2 + len(ZOO_TABLE_METRICS)) + "|"]
+        for n in ns:
+            for s in present:
+                cells = []
+                for metric, _, digits in ZOO_TABLE_METRICS:
+                    v = value.get((m, n, s, metric))
+                    cells.append("" if v is None or math.isnan(v) else f"{v:.{digits}f}")
+                out.append(f"| {n} | {s} | " + " | ".join(cells) + " |")
+        out.append("")
+    return "\n".join(out)

@@ -58,3 +58,14 @@ def test_report_draws_the_training_figure_of_zoo_curves(tmp_path):
     # no curves, no figure
     write_compare(results, tmp_path / "bare", plots=True)
     assert not (tmp_path / "bare" / "B-training.png").exists()
+
+
+def test_zoo_tables_read_the_comparison(tmp_path):
+    from patrolsb3.report import zoo_tables
+    zoo_row = fake("A", 2, "zoo:rl-msg", float("nan"))
+    zoo_row["summary"]["max_idleness_all"] = {"mean": 321.0, "std": 0.0, "tests": [321.0]}
+    write_compare([fake("A", 2, "CR", 7.25), zoo_row], tmp_path, plots=False)
+    text = zoo_tables(tmp_path / "results.csv")
+    assert "### Map A" in text
+    assert "| 2 | zoo:rl-msg |  | 321.0 | 1.0 |  |" in text          # no AVG (all); MAX (no BF) nan
+    assert "| 2 | CR |  |  | 1.0 | 7.2 |" in text
