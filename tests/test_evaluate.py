@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from patrolsb3 import cli
+from patrolsb3 import cli, zoo
 from patrolsb3.core import load_map, make_config
 from patrolsb3.evaluate import evaluate, load_policy, parse_faults, run_episodes, summarize
 
@@ -104,7 +104,12 @@ def test_cli_compare_writes_paper_tables(tmp_path):
         rows = list(csv.reader((tmp_path / f"A-{suffix}.csv").open()))
         assert rows[0] == ["n", "CR", "PART", "SEBS", "INTENTION", "NOMSG", "MSG"]
         assert [r[0] for r in rows[1:]] == ["1", "2"]
-        assert all(r[4:] == ["", "", ""] for r in rows[1:])     # no zoo model: empty cells
+        for column, variant in zip(rows[0][4:], ("rl-intention", "rl-no-msg", "rl-msg")):
+            cells = [r[rows[0].index(column)] for r in rows[1:]]
+            if not zoo.available("A", variant):
+                assert cells == ["", ""]                      # no zoo model: empty, not invented
+            elif suffix == "BF":
+                assert all(c != "" for c in cells)            # a zoo model always has a failure rate
         assert all(r[1] != "" for r in rows[1:] if suffix != "BLv")
         extra = list(csv.reader((tmp_path / f"A-{suffix}-extra.csv").open()))
         assert extra[0] == ["n", "RANDOM", "CYCLIC"]

@@ -121,3 +121,22 @@ def test_learns_to_beat_random_on_a_corridor(tmp_path):
     trained = np.mean([r["mean_idleness"] for r in evaluate(model, env)])
     random = np.mean([r["mean_idleness"] for r in evaluate(RandomMaskedPolicy(seed=1), env)])
     assert trained < 0.8 * random, (trained, random)
+
+
+def test_reward_normalisation_saves_and_resumes_its_statistics(tmp_path):
+    from stable_baselines3.common.vec_env import VecNormalize
+
+    from patrolsb3.sb3.train import VECNORMALIZE_FILE, normalized_rewards
+    run = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(normalize_reward=True),
+                progress_bar=False)
+    stats_file = run / "checkpoints" / VECNORMALIZE_FILE.format(400)
+    assert stats_file.is_file()
+    saved = VecNormalize.load(str(stats_file), make_vec_env(ROOM, agents=[1] * 8, seed=0))
+    assert not saved.norm_obs and saved.norm_reward
+    assert saved.ret_rms.count > 100           # updated at every env step
+    # resume loads those statistics instead of starting fresh ones
+    resumed = normalized_rewards(make_vec_env(ROOM, agents=[1] * 8, seed=0), newest_checkpoint(run), gamma=0.9)
+    assert resumed.ret_rms.count == saved.ret_rms.count
+    train(map=ROOM, timesteps=800, out=tmp_path, hyperparams=tiny_hp(normalize_reward=True), resume=True,
+          progress_bar=False)
+    assert (run / "checkpoints" / VECNORMALIZE_FILE.format(800)).is_file()

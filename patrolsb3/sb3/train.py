@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import yaml
+from stable_baselines3.common.vec_env import VecNormalize
 
 from .algorithms import DEFAULT_ALGORITHM, get_algorithm
 from .curriculum import CURRICULUM, curriculum_stage
@@ -30,8 +31,10 @@ from .hyperparams import load_hyperparams, merge, per_phase, schedule
 ALGO_KEYS = ("learning_rate", "n_steps", "n_epochs", "gamma", "gae_lambda", "clip_range", "ent_coef",
              "vf_coef", "max_grad_norm", "n_minibatches", "batch_size", "policy_kwargs", "target_kl")
 RUN_KEYS = ("algo", "timesteps", "n_envs", "curriculum", "env", "checkpoint_freq", "eval_freq",
-            "eval_episode_steps", "eval_episodes", "torch_threads")
+            "eval_episode_steps", "eval_episodes", "torch_threads", "normalize_reward")
 CHECKPOINT_RE = re.compile(r"model_(\d+)_steps\.zip$")
+VECNORMALIZE_FILE = "model_vecnormalize_{}_steps.pkl"
+"""Reward-normalisation statistics saved beside each checkpoint (SB3's CheckpointCallback name)."""
 
 
 def curriculum_teams(n_envs: int, max_agents: int, curriculum=CURRICULUM) -> list[list[int]]:
@@ -93,6 +96,27 @@ def algorithm_kwargs(hp: dict, spec, layout: dict, phases_per_step: int, rows: i
                 ent_coef=float(hp["ent_coef"]), vf_coef=float(hp["vf_coef"]),
                 max_grad_norm=float(hp["max_grad_norm"]), target_kl=hp.get("target_kl"),
                 policy_kwargs=policy_kwargs_for(layout, **policy_kwargs))
+
+
+def normalized_rewards(vec_env, checkpoint: Path | None, gamma: float):
+    """SB3's ``VecNormalize`` on rewards only (observations are already scaled by the env).
+
+    The policy and value losses share one optimizer and one gradient-norm clip, so raw returns
+    of -1,000 (battery failures) would let the value loss swamp the policy gradient; scaling
+    rewards by the running std of the discounted return keeps both in range. Only training
+    sees it: rewards in curve.csv and every evaluation are the env's own. On resume the
+    statistics saved beside the checkpoint are loaded (fresh ones if there are none).
+
+    Args:
+        vec_env: the training vector env.
+        checkpoint: the checkpoint being resumed, or None.
+        gamma: the per-env-step discount (the return whose std scales the rewards).
+    """
+    if checkpoint is not None:
+        stats = checkpoint.with_name(VECNORMALIZE_FILE.format(CHECKPOINT_RE.search(checkpoint.name).group(1)))
+        if stats.is_file():
+            return VecNormalize.load(str(stats), vec_env)
+    return VecNormalize(vec_env, norm_obs=False, norm_reward=True, gamma=gamma)
 
 
 def _check_resumable(run_dir: Path, config: dict) -> Path:
@@ -197,6 +221,8 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     vec_env = make_vec_env(spec_map, agents=start_teams, variant=variant, seed=seed, strict=spec.masked,
                            **env_kwargs)
     rows = vec_env.num_envs
+    if hp.get("normalize_reward", False):
+        vec_env = normalized_rewards(vec_env, checkpoint, per_phase(hp["gamma"], vec_env.phases_per_step))
     if checkpoint is not None:
         model = cls.load(checkpoint, env=vec_env, device="cpu", tensorboard_log=str(run_dir / "tb"),
                          verbose=verbose)
@@ -217,7 +243,8 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
                             strict=spec.masked, **eval_env_kwargs)
 
     callbacks = [CheckpointCallback(save_freq=max(1, int(hp.get("checkpoint_freq", 200_000)) // rows),
-                                    save_path=str(run_dir / "checkpoints"), name_prefix="model"),
+                                    save_path=str(run_dir / "checkpoints"), name_prefix="model",
+                                    save_vecnormalize=True),
                  LearningCurveCallback(run_dir / "curve.csv", max_agents),
                  PaperMetricsEvalCallback(make_eval_env, run_dir / "eval.csv", int(hp.get("eval_freq", 0)))]
     if hp.get("curriculum", True):
@@ -229,6 +256,8 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
                         progress_bar=progress_bar, tb_log_name=spec.name)
     finally:
         model.save(run_dir / "checkpoints" / f"model_{model.num_timesteps}_steps.zip")
+        if isinstance(vec_env, VecNormalize):
+            vec_env.save(str(run_dir / "checkpoints" / VECNORMALIZE_FILE.format(model.num_timesteps)))
         vec_env.close()
     model.save(run_dir / "model.zip")
     return run_dir
