@@ -211,3 +211,45 @@ def zoo_tables(results_csv, strategies=("zoo:rl-msg", "zoo:rl-no-msg", "zoo:rl-i
                 out.append(f"| {n} | {s} | " + " | ".join(cells) + " |")
         out.append("")
     return "\n".join(out)
+
+
+CURVE_SUMMARY_FIELDS = ("timesteps", "episodes", "reward_first", "reward_last", "bf_first", "bf_last",
+                        "idleness_first", "idleness_last")
+"""Columns of :func:`curve_summary`: the first and last quarter of a run's training episodes."""
+
+
+def curve_summary(curve_csv, fraction: float = 0.25) -> dict:
+    """How a training run went, from its ``curve.csv`` (one row per finished episode): the mean
+    team reward, the share of episodes with a battery failure ("bf") and the mean idleness over
+    the first and the last ``fraction`` of its episodes, the episodes and the last timesteps.
+
+    Raises:
+        ValueError: a curve without episodes (names the file).
+    """
+    with open(curve_csv, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    if not rows:
+        raise ValueError(f"{curve_csv}: no finished training episode yet")
+    k = max(1, round(len(rows) * fraction))
+
+    def mean(part, key, cast=float):
+        return sum(cast(r[key]) for r in part) / len(part)
+
+    out = {"timesteps": int(rows[-1]["timesteps"]), "episodes": len(rows)}
+    for label, part in (("first", rows[:k]), ("last", rows[-k:])):
+        out[f"reward_{label}"] = mean(part, "reward")
+        out[f"bf_{label}"] = mean(part, "battery_failures", lambda v: float(int(v) > 0))
+        out[f"idleness_{label}"] = mean(part, "mean_idleness")
+    return out
+
+
+def curve_table(curves: dict) -> str:
+    """Markdown table of :func:`curve_summary` for ``{name: curve.csv path}``."""
+    lines = ["| run | agent-steps | episodes | reward first / last quarter | battery failure share "
+             "first / last | mean idleness first / last |", "|---|---|---|---|---|---|"]
+    for name, path in curves.items():
+        s = curve_summary(path)
+        lines.append(f"| {name} | {s['timesteps']:,} | {s['episodes']} | {s['reward_first']:.0f} / "
+                     f"{s['reward_last']:.0f} | {s['bf_first']:.2f} / {s['bf_last']:.2f} | "
+                     f"{s['idleness_first']:.0f} / {s['idleness_last']:.0f} |")
+    return "\n".join(lines)
