@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Export every zoo run of runs/zoo (policy only, no optimizer state) into ZOO_DIR (default zoo),
 # side by side, with the CPU hours each run trained; EVAL_ARGS are passed to 'patrolsb3 zoo
-# export' (default --no-eval: write eval.json later with 'patrolsb3 zoo eval' or export again).
+# export' (default --no-eval: copy only; pass the evaluation options to write eval.json).
 #   zoo/export_runs.sh CPU_HOURS
 set -uo pipefail
 CPU_HOURS=${1:?usage: zoo/export_runs.sh CPU_HOURS}
