@@ -213,11 +213,6 @@ def zoo_tables(results_csv, strategies=("zoo:rl-msg", "zoo:rl-no-msg", "zoo:rl-i
     return "\n".join(out)
 
 
-CURVE_SUMMARY_FIELDS = ("timesteps", "episodes", "reward_first", "reward_last", "bf_first", "bf_last",
-                        "idleness_first", "idleness_last")
-"""Columns of :func:`curve_summary`: the first and last quarter of a run's training episodes."""
-
-
 def curve_summary(curve_csv, fraction: float = 0.25) -> dict:
     """How a training run went, from its ``curve.csv`` (one row per finished episode): the mean
     team reward, the share of episodes with a battery failure ("bf") and the mean idleness over

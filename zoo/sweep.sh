@@ -2,7 +2,8 @@
 # The settings sweep that chose the zoo's shared training settings: A/rl-msg trained side by
 # side (one process and one torch thread per setting, 16 processes on a 16-core machine), each
 # stopped cleanly after SECONDS. Compare the runs with
-#   python -m patrolsb3.report sweep runs/sweep/A/rl-msg
+#   python -c "import glob; from patrolsb3.report import curve_table; \
+#     print(curve_table({p.split('/')[-2]: p for p in sorted(glob.glob('runs/sweep/A/rl-msg/*/curve.csv'))}))"
 # Run from the repository root:  zoo/sweep.sh SECONDS
 set -uo pipefail
 SECONDS_PER_RUN=${1:?usage: zoo/sweep.sh SECONDS}
