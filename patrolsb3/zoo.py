@@ -227,6 +227,10 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None) -
     config["date"] = datetime.date.fromtimestamp(source.stat().st_mtime).isoformat()
     config["source_model"] = str(source)
     config["budget"] = {"timesteps": int(model.num_timesteps), **(budget or {})}
+    warm = (config.get("init_from") or {}).get("timesteps")
+    if warm:  # a warm-started run: its budget includes the run it started from
+        config["budget"]["timesteps_this_run"] = int(model.num_timesteps)
+        config["budget"]["timesteps"] = int(model.num_timesteps) + int(warm)
     config["source_run"] = str(run_dir)
     (folder / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
     return folder

@@ -140,3 +140,40 @@ def test_reward_normalisation_saves_and_resumes_its_statistics(tmp_path):
     train(map=ROOM, timesteps=800, out=tmp_path, hyperparams=tiny_hp(normalize_reward=True), resume=True,
           progress_bar=False)
     assert (run / "checkpoints" / VECNORMALIZE_FILE.format(800)).is_file()
+
+
+def test_init_from_starts_a_new_run_from_the_weights(tmp_path):
+    source = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
+    src_weights = MaskableRecurrentPPO.load(source / "model.zip", device="cpu").policy.state_dict()
+    # lr 0 and no curriculum: the warm-started run must keep exactly the source's weights
+    run = train(map=ROOM, timesteps=400, out=tmp_path, run_id="warm", init_from=source, progress_bar=False,
+                hyperparams=tiny_hp(learning_rate=0.0, curriculum=False))
+    model = MaskableRecurrentPPO.load(run / "model.zip", device="cpu")
+    assert model.num_timesteps == 400                                   # a fresh step count
+    for name, value in model.policy.state_dict().items():
+        assert th.equal(value, src_weights[name]), name
+    config = yaml.safe_load((run / "config.yml").read_text())
+    assert config["init_from"] == {"path": str(source / "model.zip"), "timesteps": 400}
+    # a fresh run from random weights differs from the source
+    fresh = train(map=ROOM, timesteps=400, out=tmp_path, run_id="fresh", seed=3, progress_bar=False,
+                  hyperparams=tiny_hp(learning_rate=0.0))
+    fresh_weights = MaskableRecurrentPPO.load(fresh / "model.zip", device="cpu").policy.state_dict()
+    assert any(not th.equal(v, src_weights[k]) for k, v in fresh_weights.items())
+
+
+def test_init_from_errors(tmp_path):
+    with pytest.raises(FileNotFoundError, match="--init-from"):
+        train(map=ROOM, timesteps=400, out=tmp_path, init_from=tmp_path / "nothing", progress_bar=False,
+              hyperparams=tiny_hp())
+    source = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
+    with pytest.raises(ValueError, match="only one"):
+        train(map=ROOM, timesteps=400, run_dir=source, init_from=source, resume=True, progress_bar=False,
+              hyperparams=tiny_hp())
+    big = parse_map("S.......\n........\n........\n........", name="big")
+    with pytest.raises(ValueError, match="does not match"):
+        train(map=big, timesteps=400, out=tmp_path, init_from=source, progress_bar=False, hyperparams=tiny_hp())
+    junk = tmp_path / "junk.zip"
+    junk.write_bytes(b"not a zip")
+    with pytest.raises(ValueError, match="cannot be loaded"):
+        train(map=ROOM, timesteps=400, out=tmp_path, run_id="j", init_from=junk, progress_bar=False,
+              hyperparams=tiny_hp())

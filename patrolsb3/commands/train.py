@@ -12,6 +12,8 @@ def add_arguments(parser):
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--run-id", default=None, help="run folder name (default <algo>_seed<seed>)")
     parser.add_argument("--resume", action="store_true", help="continue the run folder from its newest checkpoint")
+    parser.add_argument("--init-from", default=None, metavar="MODEL",
+                        help="start a new run from the policy weights of a checkpoint, run folder or zoo entry")
     parser.add_argument("--hyperparams", default=None, help="YAML keyed by map with a default: entry")
     parser.add_argument("--set", nargs="+", action="extend", default=[], metavar="KEY=VALUE",
                         help="override hyperparameters, e.g. n_steps=128 policy_kwargs.lstm_hidden_size=64 "
@@ -28,7 +30,7 @@ def run(args):
     from ..sb3.hyperparams import parse_set
     from ..sb3.train import train
     run_dir = train(map=args.map, variant=args.variant, timesteps=args.timesteps, out=args.out, algo=args.algo,
-                    seed=args.seed, resume=args.resume, hyperparams=parse_set(args.set),
+                    seed=args.seed, resume=args.resume, init_from=args.init_from, hyperparams=parse_set(args.set),
                     hyperparams_file=args.hyperparams, eval_freq=args.eval_freq,
                     checkpoint_freq=args.checkpoint_freq, progress_bar=not args.no_progress,
                     verbose=args.verbose, run_id=args.run_id, command="patrolsb3 " + " ".join(sys.argv[1:]))

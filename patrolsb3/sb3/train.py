@@ -141,8 +141,48 @@ def _check_resumable(run_dir: Path, config: dict) -> Path:
     return checkpoint
 
 
+def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]:
+    """The policy weights of a previous model, to start a new run from them (``--init-from``).
+
+    Args:
+        init_from: a checkpoint of ``patrolsb3 train`` (``model_<steps>_steps.zip`` or a run's
+            ``model.zip``), a zoo ``model.zip`` (policy only), or a folder holding ``model.zip``
+            (a run folder or a zoo entry).
+        algo_class, policy_class: the classes of this run's algorithm.
+
+    Returns:
+        (state_dict of the policy, {"path": str, "timesteps": agent-steps it was trained for}).
+
+    Raises:
+        FileNotFoundError: nothing loadable at that path.
+        ValueError: a file that is neither a model nor a policy of this algorithm.
+    """
+    path = Path(init_from)
+    if path.is_dir():
+        path = path / "model.zip"
+    if not path.is_file():
+        raise FileNotFoundError(f"--init-from: no model at {path} (give a checkpoint .zip, a zoo "
+                                f"model.zip or a folder holding model.zip)")
+    errors = []
+    try:  # a whole model (checkpoint or run's model.zip)
+        model = algo_class.load(str(path), device="cpu")
+        return model.policy.state_dict(), {"path": str(path), "timesteps": int(model.num_timesteps)}
+    except Exception as exc:  # noqa: BLE001 - try the policy-only layout next
+        errors.append(f"as a {algo_class.__name__}: {type(exc).__name__}: {exc}")
+    try:  # a policy only (the zoo's model.zip)
+        policy = policy_class.load(str(path), device="cpu")
+    except Exception as exc:  # noqa: BLE001
+        errors.append(f"as a {policy_class.__name__}: {type(exc).__name__}: {exc}")
+        raise ValueError(f"--init-from: {path} cannot be loaded ({'; '.join(errors)})") from exc
+    timesteps = None
+    config_file = path.parent / "config.yml"
+    if config_file.is_file():
+        timesteps = (yaml.safe_load(config_file.read_text()) or {}).get("budget", {}).get("timesteps")
+    return policy.state_dict(), {"path": str(path), "timesteps": timesteps}
+
+
 def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="runs/", algo: str | None = None,
-          seed: int = 0, resume: bool = False, hyperparams: dict | None = None, hyperparams_file=None,
+          seed: int = 0, resume: bool = False, init_from=None, hyperparams: dict | None = None, hyperparams_file=None,
           n_envs: int | None = None, eval_freq: int | None = None, checkpoint_freq: int | None = None,
           progress_bar: bool = True, verbose: int = 0, run_id: str | None = None, run_dir=None,
           command: str | None = None) -> Path:
@@ -157,6 +197,10 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
         seed: seed of the env and the algorithm.
         resume: continue the run folder from its newest checkpoint (step count, curriculum
             stage and learning-rate schedule continue; curve.csv is appended).
+        init_from: start a new run from the policy weights of another model (a checkpoint, a
+            run folder or a zoo entry of the same map size, variant and algorithm): a warm
+            start with a fresh optimizer, step count, schedules and reward statistics. The
+            source and its training steps are recorded in config.yml as ``init_from``.
         hyperparams: overrides of the YAML hyperparameters (nested dicts merge).
         hyperparams_file: a YAML keyed by map with a ``default:`` entry (default: the package's).
         n_envs, eval_freq, checkpoint_freq: shortcuts overriding those hyperparameters.
@@ -171,7 +215,8 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
 
     Raises:
         ValueError: unknown algorithm / variant / hyperparameter, a run folder that exists
-            without ``resume``, or a resume against another map / env version.
+            without ``resume``, or a resume against another map / env version, or an
+            ``init_from`` model whose network does not match this run's.
         FileNotFoundError: ``resume`` without a checkpoint (names where it looked).
     """
     import torch
@@ -206,6 +251,12 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
               "variant": variant, "algo": spec.name, "seed": int(seed), "timesteps": total,
               "env": cfg.to_dict(), "hyperparams": hp, "versions": versions()}
     checkpoint = None
+    cls, policy_cls = spec.classes()
+    if resume and init_from is not None:
+        raise ValueError("--init-from starts a new run; --resume continues one: give only one of them")
+    warm_weights = None
+    if init_from is not None:
+        warm_weights, config["init_from"] = warm_start_weights(init_from, cls, policy_cls)
     if resume:
         checkpoint = _check_resumable(run_dir, config)
     elif run_dir.exists() and any(run_dir.iterdir()):
@@ -216,7 +267,6 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     with (run_dir / "command.txt").open("a") as f:
         f.write((command or " ".join(sys.argv)) + "\n")
 
-    cls, policy_cls = spec.classes()
     start_teams = teams[0] if hp.get("curriculum", True) else final_teams
     vec_env = make_vec_env(spec_map, agents=start_teams, variant=variant, seed=seed, strict=spec.masked,
                            **env_kwargs)
@@ -233,6 +283,12 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
         kwargs = algorithm_kwargs(hp, spec, vec_env.layout, vec_env.phases_per_step, rows)
         model = cls(policy_cls, vec_env, tensorboard_log=str(run_dir / "tb"), seed=seed, verbose=verbose,
                     device="cpu", **kwargs)
+        if warm_weights is not None:
+            try:
+                model.policy.load_state_dict(warm_weights)
+            except RuntimeError as exc:
+                raise ValueError(f"--init-from {config['init_from']['path']}: its network does not match "
+                                 f"this run's (another map size, variant or policy_kwargs?): {exc}") from exc
 
     max_agents = vec_env.layout["critic_size"] // 3
     eval_teams = [k for k in range(1, max_agents + 1) if k <= spec_map.n_vertices] * int(hp.get("eval_episodes", 1))
