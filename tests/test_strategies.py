@@ -182,3 +182,22 @@ def test_no_strategy_beats_the_lower_bound(map_name):
             assert r["avg_idleness"][e] >= b["avg"] - 1e-9, (name, k)
             assert r["max_idleness"][e] >= b["avg"] - 1e-9, (name, k)
             assert r["worst_idleness"][e] >= b["worst"], (name, k)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_patrolling_agent_gives_way_to_an_agent_heading_home(name):
+    # dead-end corridor S-a-b-c-d: agent 0 (full battery) stands next to the station, agent 1
+    # (battery low, heading home) right behind it. Without the right-of-way rule agent 0 has
+    # no patrol move (station ahead, agent 1 behind) and both wait until agent 1 fails.
+    spec = parse_map("S....")
+    cfg = make_config(None, max_agents=2, p_dyn_max=0.0, init_battery=(1.0, 1.0))
+    sim = reset_state(spec, cfg, 2, n_envs=1, seed=0)
+    sim.pos[0] = [1, 2]
+    sim.battery[0, 1] = cfg.b_low - 5.0
+    policy = strategies.get(name, spec, 2, cfg, seed=0)
+    actions, memory = policy.predict(sim, None)
+    assert memory["returning"][0].tolist() == [False, True]
+    assert actions[0, 0, 1] == 2          # agent 0 backs onto the station (Left): its only way out
+    for _, info in run(policy, spec, cfg, sim, 10):
+        assert not info.battery_failed.any()
+    assert (sim.status[0] == 1).all()     # both are swapping batteries now

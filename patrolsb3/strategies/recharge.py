@@ -19,9 +19,13 @@ arrival starts no swap) steps off and back on.
 Deadlocks: any number of agents may share a station, so arrivals never wait for each other
 there; agents leave a station only while no agent heading home is within
 ``STATION_CLEARANCE`` steps of it (the station exit rule: dead-end corridors to the station
-stay one-way). In corridors a returning agent has priority: patrolling agents move aside after
-``PATROL_PATIENCE`` blocked steps, a returning agent only after ``HOME_PATIENCE``
-(see :meth:`patrolsb3.strategies.navigation.Navigator.unblock`).
+stay one-way). An agent heading home has right of way: a patrolling agent standing on the
+cell a blocked returning agent needs next (any shortest-path step toward its station) gives
+way at once with a random valid move, backing onto the station (and swapping early) only
+when that is its only way out, as in a dead-end corridor that leads to the station
+(:meth:`RechargePlanner.in_the_way`). Other blockages follow the general deadlock rule:
+patrolling agents move aside after ``PATROL_PATIENCE`` blocked steps, a returning agent only
+after ``HOME_PATIENCE`` (see :meth:`patrolsb3.strategies.navigation.Navigator.unblock`).
 """
 from __future__ import annotations
 
@@ -84,6 +88,32 @@ class RechargePlanner:
     def home_traffic(self, sim: State, returning: np.ndarray) -> np.ndarray:
         """(E,) bool: an agent heading home is within ``STATION_CLEARANCE`` steps of a station."""
         return (returning & (self.steps_home[sim.pos] <= STATION_CLEARANCE)).any(axis=1)
+
+    def in_the_way(self, nav: Navigator, sim: State, returning: np.ndarray, home_stuck: np.ndarray) -> np.ndarray:
+        """Patrolling agents that block an agent heading home (they must give way).
+
+        Args:
+            nav: the navigator (its station-avoiding distances).
+            sim: the batched simulator state.
+            returning: (E, A) bool, agents heading home.
+            home_stuck: (E, A) bool, returning agents with no valid step toward their station.
+
+        Returns:
+            (E, A) bool: active agents not heading home that stand on a cell one step closer
+            to the station of a stuck returning agent of the same episode (its next cell on
+            some shortest path, other agents ignored).
+        """
+        pos = sim.pos                                                            # (E, A)
+        goal = self.station_of_cell[pos]                                         # (E, A)
+        here = nav.distance(pos, goal)                                           # (E, A)
+        nxt = self.spec.neighbour[pos]                                           # (E, A, 5)
+        closer = (self.spec.move_ok[pos]
+                  & (nav.distance(nxt, goal[..., None]) == here[..., None] - 1))  # (E, A, 5)
+        wants = closer & (returning & home_stuck)[..., None]                     # (E, A, 5)
+        # blocker[e, j]: some agent i of episode e wants the cell of agent j next
+        hits = wants[:, :, None, :] & (nxt[:, :, None, :] == pos[:, None, :, None])  # (E, A_i, A_j, 5)
+        blocker = hits.any(axis=(1, 3))                                          # (E, A)
+        return blocker & (sim.status == ACTIVE) & ~returning
 
     def moves(self, nav: Navigator, sim: State, mask: np.ndarray):
         """Moves toward the nearest station for every slot (meaningful where heading home).
