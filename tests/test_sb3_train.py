@@ -159,6 +159,12 @@ def test_init_from_starts_a_new_run_from_the_weights(tmp_path):
                   hyperparams=tiny_hp(learning_rate=0.0))
     fresh_weights = MaskableRecurrentPPO.load(fresh / "model.zip", device="cpu").policy.state_dict()
     assert any(not th.equal(v, src_weights[k]) for k, v in fresh_weights.items())
+    # a run stopped early (no model.zip): its newest checkpoint
+    (source / "model.zip").unlink()
+    stopped = train(map=ROOM, timesteps=400, out=tmp_path, run_id="from-stopped", init_from=source,
+                    progress_bar=False, hyperparams=tiny_hp())
+    assert yaml.safe_load((stopped / "config.yml").read_text())["init_from"] == {
+        "path": str(source / "checkpoints" / "model_400_steps.zip"), "timesteps": 400}
 
 
 def test_init_from_errors(tmp_path):

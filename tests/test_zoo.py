@@ -60,6 +60,18 @@ def test_export_of_a_stopped_run_takes_its_newest_checkpoint(trained, tmp_path):
         zoo.export(run, zoo_dir=tmp_path / "zoo")
 
 
+def test_export_of_a_warm_started_run_counts_both_stages(trained, tmp_path):
+    hp = {"n_steps": 16, "n_minibatches": 2, "n_envs": 2, "eval_freq": 0, "checkpoint_freq": 10**9,
+          "env": {"episode_steps": 20}, "policy_kwargs": {"dense_sizes": [32, 16], "lstm_hidden_size": 8}}
+    # from the zoo entry (policy only): its budget is read from the entry's config.yml
+    run = train(map=str(trained["map_file"]), variant="rl-msg", timesteps=320, run_dir=tmp_path / "warm",
+                hyperparams=hp, init_from=trained["folder"], progress_bar=False)
+    first = yaml.safe_load((trained["folder"] / "config.yml").read_text())["budget"]["timesteps"]
+    folder = zoo.export(run, zoo_dir=tmp_path / "zoo")
+    budget = yaml.safe_load((folder / "config.yml").read_text())["budget"]
+    assert budget["timesteps_this_run"] == 320 and budget["timesteps"] == 320 + first
+
+
 def test_flat_observation_is_the_training_layout():
     vec = make_vec_env(map="B", agents=[3], variant="rl-msg", seed=3)
     obs = vec.reset()                                                    # (5, D)

@@ -7,7 +7,10 @@
 #
 # ZOO_SET holds the hyperparameters every zoo run shares (applied to every variant alike, see
 # zoo/README.md); ABLATIONS adds runs of A/rl-msg that change one thing of it, for the README's
-# ablation table (ABLATIONS="" runs none). Logs go to runs/logs/, run folders to runs/zoo and runs/ablation.
+# ablation table (ABLATIONS="" runs none). Logs go to runs/logs/, run folders to ZOO_OUT
+# (default runs/zoo) and runs/ablation. INIT_FROM (optional, e.g.
+# "runs/stage1/{map}/{variant}/MaskableRecurrentPPO_seed0") starts each new zoo run from the
+# weights of that run ({map} and {variant} filled in; see zoo/train_two_stage.sh).
 set -uo pipefail
 SECONDS_PER_CALL=${1:?usage: zoo/train_parallel.sh SECONDS [--resume]}
 RESUME=${2:-}
@@ -20,18 +23,27 @@ ABLATIONS=${ABLATIONS-"rl-msg-seed1|1|$ZOO_SET
 rl-no-msg-seed1|1|$ZOO_SET
 rl-intention-seed1|1|$ZOO_SET
 rl-msg-paper-settings|0|env.episode_steps=1000"}
+ZOO_OUT=${ZOO_OUT:-runs/zoo}
+INIT_FROM=${INIT_FROM:-}
 mkdir -p runs/logs
+
+init_from() {  # out map variant -> "--init-from PATH" for a new zoo run when INIT_FROM is set
+  if [ -n "$INIT_FROM" ] && [ -z "$RESUME" ] && [ "$1" = "$ZOO_OUT" ]; then
+    local path=${INIT_FROM//\{map\}/$2}
+    echo "--init-from ${path//\{variant\}/$3}"
+  fi
+}
 
 launch() {  # out map variant run_id seed settings...
   local out=$1 map=$2 variant=$3 run_id=$4 seed=$5; shift 5
   nohup timeout -s INT "$SECONDS_PER_CALL" patrolsb3 train --map "$map" --variant "$variant" \
-    --timesteps "$TIMESTEPS" --out "$out" --run-id "$run_id" --seed "$seed" $RESUME --no-progress \
+    --timesteps "$TIMESTEPS" --out "$out" --run-id "$run_id" --seed "$seed" $RESUME $(init_from "$out" "$map" "$variant") --no-progress \
     --checkpoint-freq 250000 --eval-freq 0 --set $* \
     >> "runs/logs/${out##*/}_${map}_${variant}_${run_id}.log" 2>&1 &
 }
 
 for run in $ZOO_RUNS; do
-  launch runs/zoo "${run%%:*}" "${run#*:}" MaskableRecurrentPPO_seed0 0 $ZOO_SET
+  launch "$ZOO_OUT" "${run%%:*}" "${run#*:}" MaskableRecurrentPPO_seed0 0 $ZOO_SET
 done
 while IFS='|' read -r name seed settings; do
   variant=${name%%-seed1}; variant=${variant%%-paper-settings}

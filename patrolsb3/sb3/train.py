@@ -146,8 +146,8 @@ def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]
 
     Args:
         init_from: a checkpoint of ``patrolsb3 train`` (``model_<steps>_steps.zip`` or a run's
-            ``model.zip``), a zoo ``model.zip`` (policy only), or a folder holding ``model.zip``
-            (a run folder or a zoo entry).
+            ``model.zip``), a zoo ``model.zip`` (policy only), or a folder: a zoo entry or a
+            run folder (its ``model.zip``, or the newest checkpoint of a run stopped early).
         algo_class, policy_class: the classes of this run's algorithm.
 
     Returns:
@@ -158,8 +158,8 @@ def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]
         ValueError: a file that is neither a model nor a policy of this algorithm.
     """
     path = Path(init_from)
-    if path.is_dir():
-        path = path / "model.zip"
+    if path.is_dir():   # a zoo entry or a finished run: model.zip; a stopped run: its newest checkpoint
+        path = path / "model.zip" if (path / "model.zip").is_file() else (newest_checkpoint(path) or path / "model.zip")
     if not path.is_file():
         raise FileNotFoundError(f"--init-from: no model at {path} (give a checkpoint .zip, a zoo "
                                 f"model.zip or a folder holding model.zip)")
