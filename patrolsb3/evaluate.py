@@ -82,7 +82,7 @@ def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0):
 
 
 def run_episodes(policy, spec, cfg, n_agents: int, n_envs: int, seed: int = 0, progress=False,
-                 desc: str = "") -> dict:
+                 desc: str = "", deterministic: bool = True) -> dict:
     """Run ``n_envs`` episodes of ``cfg.episode_steps`` steps together.
 
     Args:
@@ -94,12 +94,16 @@ def run_episodes(policy, spec, cfg, n_agents: int, n_envs: int, seed: int = 0, p
         seed: seed of the simulator.
         progress: show a tqdm progress bar over steps.
         desc: label of the progress bar.
+        deterministic: passed to ``predict``: a learned policy takes its most likely legal
+            action (True) or samples one (False); heuristics ignore it.
 
     Returns:
         The per-episode figures of :meth:`EpisodeMetrics.result` plus ``segments``.
     """
     sim = reset_state(spec, cfg, n_agents, n_envs=n_envs, seed=seed)
     metrics = EpisodeMetrics(n_envs, spec.n_vertices, boundaries=[s + 1 for s, _ in cfg.faults])
+    if not deterministic and hasattr(policy, "seed_sampling"):
+        policy.seed_sampling(seed)                     # sampled actions reproducible per seed
     memory = None
     episode_start = np.ones(n_envs, dtype=bool)
     steps = range(cfg.episode_steps)
@@ -108,7 +112,7 @@ def run_episodes(policy, spec, cfg, n_agents: int, n_envs: int, seed: int = 0, p
         steps = tqdm(steps, desc=desc, unit="step", leave=False, mininterval=0.5)
     for _ in steps:
         actions, memory = policy.predict(sim, state=memory, episode_start=episode_start,
-                                         deterministic=True)
+                                         deterministic=deterministic)
         info = step(spec, cfg, sim, actions[..., 1], messages=actions[..., 0], compute_reward=False)
         metrics.update(sim, info)
         episode_start[:] = False
@@ -165,7 +169,8 @@ def summarize(per_episode: dict, tests: int) -> dict:
 
 
 def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100, tests: int = 1,
-             steps: int = 14400, seed: int = 0, faults=(), progress: bool = True, **env) -> dict:
+             steps: int = 14400, seed: int = 0, faults=(), progress: bool = True, deterministic: bool = True,
+             **env) -> dict:
     """Evaluate one strategy on one map and team size (the ``patrolsb3 evaluate`` command).
 
     Args:
@@ -178,6 +183,8 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
         seed: seed of the simulator and the strategy.
         faults: ((step, k), ...) scheduled hardware failures.
         progress: show a progress bar.
+        deterministic: a zoo model takes its most likely legal action (True, SB3's evaluation
+            default) or samples from its policy (False); heuristics are unaffected.
         **env: other EnvConfig fields (e.g. p_dyn_max=0).
 
     Returns:
@@ -202,9 +209,10 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
     if policy_cfg is not None and policy_cfg.max_agents != cfg.max_agents:
         cfg = make_config(None, **{**cfg.to_dict(), "max_agents": policy_cfg.max_agents})
     per_episode = run_episodes(policy, spec, cfg, n_agents, tests * episodes, seed=seed,
-                               progress=progress, desc=f"{strategy} map {spec.name} n={n_agents}")
+                               progress=progress, desc=f"{strategy} map {spec.name} n={n_agents}",
+                               deterministic=deterministic)
     return {"strategy": name, "map": spec.name, "n_agents": int(n_agents),
             "episodes": int(episodes), "tests": int(tests), "steps": int(steps), "seed": int(seed),
-            "faults": [list(f) for f in faults], "env": cfg.to_dict(),
+            "faults": [list(f) for f in faults], "deterministic": bool(deterministic), "env": cfg.to_dict(),
             "summary": summarize(per_episode, tests),
             "bounds": idleness_lower_bounds(spec.n_vertices, n_agents, steps)}

@@ -100,6 +100,11 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
         md += [f"{r0['tests']} test(s) x {r0['episodes']} episodes x {r0['steps']} steps per "
                f"(map, strategy, team size); mean +- std over tests. Idleness and collision figures "
                f"average over episodes without a battery failure (counts in results.csv).", ""]
+        learned = [r for r in results if str(r.get("strategy", "")).startswith("zoo:")]
+        if learned:
+            sampled = any(r.get("deterministic", True) is False for r in learned)
+            md += [f"Zoo models {'sample their actions from the policy' if sampled else 'take their most likely legal action'}"
+                   f" ({'--stochastic' if sampled else 'deterministic, the default'}).", ""]
     for m in maps:
         for suffix, metric in PAPER_TABLES.items():
             md += [f"## Map {m}: {suffix} ({LABELS[metric]})", ""]
@@ -136,14 +141,14 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
     with long_path.open("w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(["map", "n", "strategy", "metric", "mean", "std", "clean_episodes",
-                         "episodes", "tests", "steps"])
+                         "episodes", "tests", "steps", "deterministic"])
         for r in results:
             metrics = [m for m, v in r["summary"].items() if isinstance(v, dict) and "mean" in v]
             for metric in metrics:                 # LABELS' metrics and their *_all twins
                 s = r["summary"][metric]
                 writer.writerow([r["map"], r["n_agents"], r["strategy"], metric, s["mean"], s["std"],
                                  sum(r["summary"]["clean_episodes"]), r["episodes"] * r["tests"],
-                                 r["tests"], r["steps"]])
+                                 r["tests"], r["steps"], r.get("deterministic", True)])
     written.append(long_path)
     report = out / "report.md"
     report.write_text("\n".join(md) + "\n")

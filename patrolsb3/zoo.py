@@ -100,6 +100,11 @@ class ZooPolicy:
             actions, _ = self.policy.predict(obs, deterministic=self._deterministic, action_masks=masks)
         return np.asarray(actions).reshape(E, A, 2), lstm
 
+    def seed_sampling(self, seed: int) -> None:
+        """Seed torch's generator, which draws the sampled actions (``deterministic=False``)."""
+        import torch
+        torch.manual_seed(int(seed))
+
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         """Act for every slot of the batched simulator state ``observation``.
 
@@ -237,7 +242,7 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None) -
 
 
 def write_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0, tests: int = 1,
-               progress: bool = True) -> Path:
+               progress: bool = True, deterministic: bool = True) -> Path:
     """Evaluate a zoo entry for 1..max_agents agents and write ``eval.json`` beside it.
 
     All team sizes run in one batch (episodes x tests per size) so the policy's forward passes
@@ -251,9 +256,10 @@ def write_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0, te
         seed: simulator seed.
         tests: tests per team size.
         progress: progress bar.
+        deterministic: most likely legal actions (True) or sampled ones (False).
 
     Returns:
-        Path of eval.json: {"map", "strategy", "episodes", "tests", "steps", "seed",
+        Path of eval.json: {"map", "strategy", "episodes", "tests", "steps", "seed", "deterministic",
         "results": [evaluate()-style dict per team size]}.
     """
     from .core.config import make_config
@@ -267,18 +273,20 @@ def write_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0, te
     per_size = episodes * tests
     team = np.repeat(np.arange(1, max_agents + 1), per_size)                # (max_agents * per_size,)
     per_episode = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, progress=progress,
-                               desc=f"zoo {config['map']}/{config['variant']} n=1..{max_agents}")
+                               desc=f"zoo {config['map']}/{config['variant']} n=1..{max_agents}",
+                               deterministic=deterministic)
     strategy = f"zoo:{config['variant']}"
     results = []
     for n in range(1, max_agents + 1):
         rows = team == n
         part = {k: v[rows] for k, v in per_episode.items() if isinstance(v, np.ndarray)}
         results.append({"strategy": strategy, "map": config["map"], "n_agents": n, "episodes": episodes,
-                        "tests": tests, "steps": steps, "seed": seed, "faults": [], "env": cfg.to_dict(),
+                        "tests": tests, "steps": steps, "seed": seed, "faults": [],
+                        "deterministic": bool(deterministic), "env": cfg.to_dict(),
                         "summary": summarize(part, tests),
                         "bounds": idleness_lower_bounds(policy.spec.n_vertices, n, steps)})
     out = {"map": config["map"], "strategy": strategy, "episodes": episodes, "tests": tests,
-           "steps": steps, "seed": seed, "deterministic": True,
+           "steps": steps, "seed": seed, "deterministic": bool(deterministic),
            "note": "all team sizes stepped in one batch; episodes of size n are rows n-1 of the batch",
            "results": results}
     path = folder / "eval.json"
@@ -287,13 +295,13 @@ def write_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0, te
 
 
 def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, steps: int, seed: int,
-                  tests: int = 1, zoo_dir=None):
-    """The entry's eval.json result for exactly this protocol, or None."""
+                  tests: int = 1, zoo_dir=None, deterministic: bool = True):
+    """The entry's eval.json result for exactly this protocol and action mode, or None."""
     path = entry_dir(map_name, variant, zoo_dir) / "eval.json"
     if not path.is_file():
         return None
     data = json.loads(path.read_text())
-    if (data.get("episodes"), data.get("steps"), data.get("seed"), data.get("tests")) != \
-            (episodes, steps, seed, tests):
+    if (data.get("episodes"), data.get("steps"), data.get("seed"), data.get("tests"),
+            data.get("deterministic", True)) != (episodes, steps, seed, tests, deterministic):
         return None
     return next((r for r in data.get("results", []) if r["n_agents"] == n_agents), None)

@@ -117,6 +117,18 @@ def test_cli_compare_writes_paper_tables(tmp_path):
     assert "## Map A: MAX" in (tmp_path / "report.md").read_text()
 
 
+@pytest.mark.skipif(not zoo.available("A", "rl-msg"), reason="needs the zoo's A/rl-msg")
+def test_cli_compare_stochastic_samples_the_zoo_model(tmp_path):
+    args = ["compare", "--maps", "A", "--agents", "2", "--episodes", "2", "--steps", "60",
+            "--strategies", "zoo:rl-msg", "--no-progress"]
+    assert cli.main(args + ["--out", str(tmp_path / "greedy")]) == 0
+    assert cli.main(args + ["--stochastic", "--out", str(tmp_path / "sampled")]) == 0
+    assert "most likely legal action" in (tmp_path / "greedy" / "report.md").read_text()
+    assert "sample their actions" in (tmp_path / "sampled" / "report.md").read_text()
+    greedy, sampled = (list(csv.DictReader((tmp_path / d / "results.csv").open())) for d in ("greedy", "sampled"))
+    assert greedy[0]["deterministic"] == "True" and sampled[0]["deterministic"] == "False"
+
+
 def test_faults_outside_the_episode_are_refused():
     with pytest.raises(ValueError, match="outside the episode"):
         evaluate("CR", "A", 2, episodes=1, steps=100, faults=((100, 1),), progress=False)

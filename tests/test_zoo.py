@@ -136,6 +136,22 @@ def test_write_eval_on_every_team_size(trained, monkeypatch):
     assert hit == data["results"][2]
     assert zoo.cached_result("ROOM", "rl-msg", 3, episodes=2, steps=31, seed=0, zoo_dir=zoo_dir) is None
     assert zoo.cached_result("ROOM", "rl-no-msg", 3, episodes=2, steps=30, seed=0, zoo_dir=zoo_dir) is None
+    assert zoo.cached_result("ROOM", "rl-msg", 3, episodes=2, steps=30, seed=0, zoo_dir=zoo_dir,
+                             deterministic=False) is None       # another action mode
+    assert data["deterministic"] is True and data["results"][2]["deterministic"] is True
+
+
+def test_sampled_actions_are_seeded_and_differ_from_greedy(trained):
+    policy = zoo.load("ROOM", "rl-msg", zoo_dir=trained["root"] / "zoo", spec=trained["map_file"])
+    spec = load_map(trained["map_file"])
+    cfg = make_config(None, episode_steps=60, invalid_action="raise")   # strict: sampled moves are legal
+
+    def idleness(deterministic, seed):
+        return run_episodes(policy, spec, cfg, 3, 4, seed=seed, deterministic=deterministic)["avg_idleness"]
+
+    np.testing.assert_array_equal(idleness(False, 1), idleness(False, 1))
+    assert not np.array_equal(idleness(False, 1), idleness(False, 2))
+    assert not np.array_equal(idleness(False, 1), idleness(True, 1))
 
 
 def test_refusals_name_the_problem(trained, tmp_path):

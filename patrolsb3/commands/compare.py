@@ -34,9 +34,11 @@ def add_arguments(parser):
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--no-progress", action="store_true")
+    parser.add_argument("--stochastic", action="store_true",
+                        help="zoo models sample their actions (default: the most likely legal action)")
     parser.add_argument("--rerun-zoo", action="store_true",
                         help="evaluate zoo models again even when their eval.json already holds this "
-                             "exact protocol (episodes, steps, seed, tests)")
+                             "exact protocol (episodes, steps, seed, tests, action mode)")
 
 
 def run(args):
@@ -80,11 +82,12 @@ def run(args):
                 r = None
                 if zoo is not None and name.startswith("zoo:") and not args.rerun_zoo:
                     r = zoo.cached_result(m, name.split(":", 1)[1], n, args.episodes, args.steps,
-                                          args.seed, args.tests)
+                                          args.seed, args.tests, deterministic=not args.stochastic)
                 source = "  (from the zoo's eval.json; --rerun-zoo to run it)" if r else ""
                 if r is None:
                     r = evaluate(name, m, n, episodes=args.episodes, tests=args.tests, steps=args.steps,
-                                 seed=args.seed, progress=not args.no_progress)
+                                 seed=args.seed, progress=not args.no_progress,
+                                 deterministic=not args.stochastic)
                 s = r["summary"]
                 print(f"map {r['map']} {name:>16} n={n}: MAX {s['max_idleness']['mean']:.1f} "
                       f"AVG {s['avg_idleness']['mean']:.1f} col {s['collisions']['mean']:.2f} "

@@ -13,6 +13,8 @@ def add_arguments(parser):
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--faults", action="append", default=[], metavar="STEP:K",
                         help="K agents fail for good at STEP (repeatable); AVG/MAX are split at each")
+    parser.add_argument("--stochastic", action="store_true",
+                        help="a zoo model samples its actions instead of taking the most likely one")
     parser.add_argument("--json", default=None, metavar="FILE", help="also write the result as JSON")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
 
@@ -22,7 +24,7 @@ def run(args):
     from ..report import evaluation_text
     result = evaluate(args.strategy, args.map, args.agents, episodes=args.episodes, tests=args.tests,
                       steps=args.steps, seed=args.seed, faults=parse_faults(args.faults),
-                      progress=not args.no_progress)
+                      progress=not args.no_progress, deterministic=not args.stochastic)
     print(evaluation_text(result))
     if args.json:
         with open(args.json, "w") as fh:

@@ -21,6 +21,8 @@ def add_arguments(parser):
     p_export.add_argument("--episodes", type=int, default=10, help="evaluation episodes per team size")
     p_export.add_argument("--steps", type=int, default=14400, help="steps per evaluation episode")
     p_export.add_argument("--seed", type=int, default=0)
+    p_export.add_argument("--stochastic", action="store_true",
+                          help="evaluate with sampled actions (default: the most likely legal action)")
     p_export.add_argument("--no-eval", action="store_true", help="copy only, no eval.json")
 
 
@@ -66,6 +68,7 @@ def export_and_evaluate(args) -> int:
     folder = export(args.run_dir, zoo_dir=args.zoo_dir, budget=budget, checkpoint=args.checkpoint)
     print(f"exported to {folder}")
     if not args.no_eval:
-        path = write_eval(folder, episodes=args.episodes, steps=args.steps, seed=args.seed)
+        path = write_eval(folder, episodes=args.episodes, steps=args.steps, seed=args.seed,
+                          deterministic=not args.stochastic)
         print(f"evaluation written to {path}")
     return 0
