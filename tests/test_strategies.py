@@ -201,3 +201,19 @@ def test_patrolling_agent_gives_way_to_an_agent_heading_home(name):
     for _, info in run(policy, spec, cfg, sim, 10):
         assert not info.battery_failed.any()
     assert (sim.status[0] == 1).all()     # both are swapping batteries now
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_a_corridor_full_of_patrolling_agents_empties_for_an_agent_heading_home(name):
+    # the station ends a one-cell corridor (1,0)-(2,0) that opens at (3,0); patrolling agents
+    # fill the corridor and its mouth, and the agent heading home waits at (3,1). The agent at
+    # the mouth cannot move at all, so the ones behind it must give way (onto the station).
+    spec = parse_map("S####\n.####\n.####\n.....")
+    cfg = make_config(None, max_agents=4, p_dyn_max=0.0, init_battery=(1.0, 1.0), swap_time=(80, 80))
+    sim = reset_state(spec, cfg, 4, n_envs=1, seed=0)
+    sim.pos[0] = [5, 10, 15, 16]                    # (1,0), (2,0), (3,0) patrol; (3,1) heads home
+    sim.battery[0, 3] = cfg.b_low - 5.0
+    swapped = False
+    for _ in run(strategies.get(name, spec, 4, cfg, seed=0), spec, cfg, sim, 30):
+        swapped |= sim.status[0, 3] == 1
+    assert swapped and not (sim.status[0] == 2).any()

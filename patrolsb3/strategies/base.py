@@ -107,7 +107,7 @@ class HeuristicPolicy:
             home, home_stuck = self.recharge.moves(self.nav, sim, mask)
             moves = np.where(returning, home, moves)
             stuck = np.where(returning, home_stuck, stuck)
-            give_way = self.recharge.in_the_way(self.nav, sim, returning, home_stuck & (sim.status == ACTIVE))
+            give_way = self.recharge.in_the_way(self.nav, sim, returning, home_stuck & active, mask)
             if give_way.any():   # right of way for agents heading home
                 moves = np.where(give_way, self.nav.retreat_moves(sim.pos, mask), moves)
                 stuck = stuck & ~give_way

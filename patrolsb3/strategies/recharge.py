@@ -22,8 +22,9 @@ there; agents leave a station only while no agent heading home is within
 stay one-way). An agent heading home has right of way: a patrolling agent standing on the
 cell a blocked returning agent needs next (any shortest-path step toward its station) gives
 way at once with a random valid move, backing onto the station (and swapping early) only
-when that is its only way out, as in a dead-end corridor that leads to the station
-(:meth:`RechargePlanner.in_the_way`). Other blockages follow the general deadlock rule:
+when that is its only way out, as in a dead-end corridor that leads to the station; when
+such an agent cannot move at all, the patrolling agents next to it give way too, so a
+corridor full of agents empties from its far end (:meth:`RechargePlanner.in_the_way`). Other blockages follow the general deadlock rule:
 patrolling agents move aside after ``PATROL_PATIENCE`` blocked steps, a returning agent only
 after ``HOME_PATIENCE`` (see :meth:`patrolsb3.strategies.navigation.Navigator.unblock`).
 """
@@ -32,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.config import EnvConfig
-from ..core.maps import MapSpec
+from ..core.maps import STAY, MapSpec
 from ..core.masks import station_cells
 from ..core.state import ACTIVE, State
 from .navigation import Navigator
@@ -89,7 +90,8 @@ class RechargePlanner:
         """(E,) bool: an agent heading home is within ``STATION_CLEARANCE`` steps of a station."""
         return (returning & (self.steps_home[sim.pos] <= STATION_CLEARANCE)).any(axis=1)
 
-    def in_the_way(self, nav: Navigator, sim: State, returning: np.ndarray, home_stuck: np.ndarray) -> np.ndarray:
+    def in_the_way(self, nav: Navigator, sim: State, returning: np.ndarray, home_stuck: np.ndarray,
+                   mask: np.ndarray) -> np.ndarray:
         """Patrolling agents that block an agent heading home (they must give way).
 
         Args:
@@ -97,11 +99,14 @@ class RechargePlanner:
             sim: the batched simulator state.
             returning: (E, A) bool, agents heading home.
             home_stuck: (E, A) bool, returning agents with no valid step toward their station.
+            mask: (E, A, 5) valid moves.
 
         Returns:
             (E, A) bool: active agents not heading home that stand on a cell one step closer
             to the station of a stuck returning agent of the same episode (its next cell on
-            some shortest path, other agents ignored).
+            some shortest path, other agents ignored), and, in a chain, the agents around
+            such a blocker that has no valid move at all (a one-cell corridor full of
+            patrolling agents empties from its far end, onto the station if that is the end).
         """
         pos = sim.pos                                                            # (E, A)
         goal = self.station_of_cell[pos]                                         # (E, A)
@@ -112,8 +117,18 @@ class RechargePlanner:
         wants = closer & (returning & home_stuck)[..., None]                     # (E, A, 5)
         # blocker[e, j]: some agent i of episode e wants the cell of agent j next
         hits = wants[:, :, None, :] & (nxt[:, :, None, :] == pos[:, None, :, None])  # (E, A_i, A_j, 5)
-        blocker = hits.any(axis=(1, 3))                                          # (E, A)
-        return blocker & (sim.status == ACTIVE) & ~returning
+        patrolling = (sim.status == ACTIVE) & ~returning & ~self.is_station[pos]   # (E, A) on a station blocks nobody
+        blocker = hits.any(axis=(1, 3)) & patrolling                             # (E, A)
+        cannot_move = ~mask[..., :STAY].any(axis=-1)                             # (E, A)
+        others = ~np.eye(pos.shape[1], dtype=bool)[None, :, :, None]             # (1, A_i, A_j, 1)
+        around = (nxt[:, :, None, :STAY] == pos[:, None, :, None]) & others      # (E, A_i, A_j, 4)
+        for _ in range(pos.shape[1] - 1):                                         # chains of blockers
+            wedged = blocker & cannot_move                                        # (E, A)
+            grown = blocker | ((wedged[:, :, None, None] & around).any(axis=(1, 3)) & patrolling)
+            if (grown == blocker).all():
+                break
+            blocker = grown
+        return blocker
 
     def moves(self, nav: Navigator, sim: State, mask: np.ndarray):
         """Moves toward the nearest station for every slot (meaningful where heading home).
