@@ -90,34 +90,37 @@ class RechargePlanner:
         """(E,) bool: an agent heading home is within ``STATION_CLEARANCE`` steps of a station."""
         return (returning & (self.steps_home[sim.pos] <= STATION_CLEARANCE)).any(axis=1)
 
-    def in_the_way(self, nav: Navigator, sim: State, returning: np.ndarray, home_stuck: np.ndarray,
-                   mask: np.ndarray) -> np.ndarray:
+    def in_the_way(self, nav: Navigator, pos: np.ndarray, active: np.ndarray, returning: np.ndarray,
+                   blocked_home: np.ndarray, mask: np.ndarray) -> np.ndarray:
         """Patrolling agents that block an agent heading home (they must give way).
 
         Args:
             nav: the navigator (its station-avoiding distances).
-            sim: the batched simulator state.
+            pos: (E, A) cells.
+            active: (E, A) bool, active agents.
             returning: (E, A) bool, agents heading home.
-            home_stuck: (E, A) bool, returning agents with no valid step toward their station.
+            blocked_home: (E, A) bool, returning agents with no valid step toward their station.
             mask: (E, A, 5) valid moves.
+
+        Callers pass only the episodes that have a blocked returning agent (the others have no
+        blocker), which keeps this off the hot path of large batches.
 
         Returns:
             (E, A) bool: active agents not heading home that stand on a cell one step closer
-            to the station of a stuck returning agent of the same episode (its next cell on
+            to the station of a blocked returning agent of the same episode (its next cell on
             some shortest path, other agents ignored), and, in a chain, the agents around
             such a blocker that has no valid move at all (a one-cell corridor full of
             patrolling agents empties from its far end, onto the station if that is the end).
         """
-        pos = sim.pos                                                            # (E, A)
         goal = self.station_of_cell[pos]                                         # (E, A)
         here = nav.distance(pos, goal)                                           # (E, A)
         nxt = self.spec.neighbour[pos]                                           # (E, A, 5)
         closer = (self.spec.move_ok[pos]
                   & (nav.distance(nxt, goal[..., None]) == here[..., None] - 1))  # (E, A, 5)
-        wants = closer & (returning & home_stuck)[..., None]                     # (E, A, 5)
+        wants = closer & blocked_home[..., None]                                 # (E, A, 5)
         # blocker[e, j]: some agent i of episode e wants the cell of agent j next
         hits = wants[:, :, None, :] & (nxt[:, :, None, :] == pos[:, None, :, None])  # (E, A_i, A_j, 5)
-        patrolling = (sim.status == ACTIVE) & ~returning & ~self.is_station[pos]   # (E, A) on a station blocks nobody
+        patrolling = active & ~returning & ~self.is_station[pos]                 # (E, A) on a station blocks nobody
         blocker = hits.any(axis=(1, 3)) & patrolling                             # (E, A)
         cannot_move = ~mask[..., :STAY].any(axis=-1)                             # (E, A)
         others = ~np.eye(pos.shape[1], dtype=bool)[None, :, :, None]             # (1, A_i, A_j, 1)
