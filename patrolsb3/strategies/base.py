@@ -107,15 +107,10 @@ class HeuristicPolicy:
             home, home_stuck = self.recharge.moves(self.nav, sim, mask)
             moves = np.where(returning, home, moves)
             stuck = np.where(returning, home_stuck, stuck)
-            blocked_home = returning & home_stuck & active                      # (E, A)
-            rows = blocked_home.any(axis=1)                                    # (E,) rare
-            if rows.any():   # right of way for agents heading home
-                give_way = np.zeros_like(returning)
-                give_way[rows] = self.recharge.in_the_way(self.nav, sim.pos[rows], active[rows], returning[rows],
-                                                          blocked_home[rows], mask[rows])
-                if give_way.any():
-                    moves = np.where(give_way, self.nav.retreat_moves(sim.pos, mask), moves)
-                    stuck = stuck & ~give_way
+            give_way = self.recharge.give_way(self.nav, sim, returning, home_stuck, mask)
+            if give_way.any():   # right of way for agents heading home
+                moves = np.where(give_way, self.nav.retreat_moves(sim.pos, mask), moves)
+                stuck = stuck & ~give_way
         leaving = active & ~returning & self.recharge.is_station[sim.pos]
         if leaving.any():   # station exit rule: let agents heading home in first
             moves = np.where(leaving & self.recharge.home_traffic(sim, returning)[:, None], STAY, moves)

@@ -24,9 +24,10 @@ cell a blocked returning agent needs next (any shortest-path step toward its sta
 way at once with a random valid move, backing onto the station (and swapping early) only
 when that is its only way out, as in a dead-end corridor that leads to the station; when
 such an agent cannot move at all, the patrolling agents next to it give way too, so a
-corridor full of agents empties from its far end (:meth:`RechargePlanner.in_the_way`). Other blockages follow the general deadlock rule:
-patrolling agents move aside after ``PATROL_PATIENCE`` blocked steps, a returning agent only
-after ``HOME_PATIENCE`` (see :meth:`patrolsb3.strategies.navigation.Navigator.unblock`).
+corridor full of agents empties from its far end (:meth:`RechargePlanner.give_way`). Other
+blockages follow the general deadlock rule: patrolling agents move aside after
+``PATROL_PATIENCE`` blocked steps, a returning agent only after ``HOME_PATIENCE`` (see
+:meth:`patrolsb3.strategies.navigation.Navigator.unblock`).
 """
 from __future__ import annotations
 
@@ -90,6 +91,29 @@ class RechargePlanner:
         """(E,) bool: an agent heading home is within ``STATION_CLEARANCE`` steps of a station."""
         return (returning & (self.steps_home[sim.pos] <= STATION_CLEARANCE)).any(axis=1)
 
+    def give_way(self, nav: Navigator, sim: State, returning: np.ndarray, home_stuck: np.ndarray,
+                 mask: np.ndarray) -> np.ndarray:
+        """(E, A) bool: patrolling agents that must give way to an agent heading home now.
+
+        Only episodes with a blocked returning agent are examined (rare in large batches);
+        :meth:`in_the_way` says who blocks.
+
+        Args:
+            nav: the navigator.
+            sim: the batched simulator state.
+            returning: (E, A) bool, agents heading home.
+            home_stuck: (E, A) bool, slots with no valid step toward their station.
+            mask: (E, A, 5) valid moves.
+        """
+        active = sim.status == ACTIVE
+        blocked_home = returning & home_stuck & active                          # (E, A)
+        rows = blocked_home.any(axis=1)                                        # (E,)
+        give_way = np.zeros_like(blocked_home)
+        if rows.any():
+            give_way[rows] = self.in_the_way(nav, sim.pos[rows], active[rows], returning[rows],
+                                             blocked_home[rows], mask[rows])
+        return give_way
+
     def in_the_way(self, nav: Navigator, pos: np.ndarray, active: np.ndarray, returning: np.ndarray,
                    blocked_home: np.ndarray, mask: np.ndarray) -> np.ndarray:
         """Patrolling agents that block an agent heading home (they must give way).
@@ -101,9 +125,6 @@ class RechargePlanner:
             returning: (E, A) bool, agents heading home.
             blocked_home: (E, A) bool, returning agents with no valid step toward their station.
             mask: (E, A, 5) valid moves.
-
-        Callers pass only the episodes that have a blocked returning agent (the others have no
-        blocker), which keeps this off the hot path of large batches.
 
         Returns:
             (E, A) bool: active agents not heading home that stand on a cell one step closer
