@@ -24,11 +24,14 @@ def action_mask(spec: MapSpec, state: State) -> np.ndarray:
         (E, A, 5) bool in action order Up, Down, Left, Right, Stay.
     """
     pos, active = state.pos, state.active                      # (E, A)
+    E, A = pos.shape
     target = spec.neighbour[pos]                               # (E, A, 5)
-    A = pos.shape[1]
-    other = ~np.eye(A, dtype=bool)[None, :, None, :]           # (1, A, 1, A) j != i
-    occupied = (active[:, None, None, :] & other
-                & (target[..., None] == pos[:, None, None, :])).any(-1)  # (E, A, 5)
+    # occupancy grid: active agents per cell, minus the slot itself where it targets its own cell
+    cells = spec.kinds.size
+    flat = (np.arange(E)[:, None] * cells + pos)[active]
+    occupancy = np.bincount(flat, minlength=E * cells).reshape(E, cells)   # (E, H*W)
+    others = occupancy[np.arange(E)[:, None, None], target] - (active[..., None] & (target == pos[..., None]))
+    occupied = others > 0                                      # (E, A, 5)
     mask = spec.move_ok[pos] & (~occupied | station_cells(spec)[target])
     mask[..., STAY] = True
     mask[~active] = np.array([False, False, False, False, True])

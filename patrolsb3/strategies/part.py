@@ -183,6 +183,7 @@ class PARTPolicy(HeuristicPolicy):
             self.parts[k, :k] = owner[None, :] == np.arange(k)[:, None]
             self.touch[k, :k, :k] = part_adjacency(self.spec, owner, k)
         self.vertex_free = self.spec.free_index[self.spec.vertex_cells]      # (V,)
+        self.dist_to_vertex = np.ascontiguousarray(self.nav.dist[:, self.vertex_free])  # (F, V)
         # table 0: the patrol table; table 1 + k * A + a: paths inside part a of a team of k
         F = len(self.spec.free_cells)
         self.tables = np.zeros((1 + (A + 1) * A, F, F), dtype=np.int32)      # (T, F, F)
@@ -201,16 +202,17 @@ class PARTPolicy(HeuristicPolicy):
     def allowed_vertices(self, sim, e_idx, a_idx) -> np.ndarray:
         """(n, V) bool: own part plus lent parts for the (episode, slot) pairs given."""
         k = sim.n_agents[e_idx]                                               # (n,)
-        parts = self.parts[k]                                                 # (n, A, V)
-        touch = self.touch[k]                                                 # (n, A, A)
+        own = self.parts[k, a_idx]                                            # (n, V)
         active = sim.status[e_idx] == ACTIVE                                  # (n, A)
         deployed = np.arange(sim.pos.shape[1])[None, :] < k[:, None]
         away = deployed & ~active                                             # (n, A) owners absent
+        if not away.any():                                                    # nothing to lend
+            return own
+        touch = self.touch[k]                                                 # (n, A, A)
         owner_near = (touch & active[:, None, :]).any(axis=2)                 # (n, A) part b has an active neighbour
         n = len(e_idx)
         lent = away & (touch[np.arange(n), a_idx] | ~owner_near)              # (n, A) parts lent to a
-        own = parts[np.arange(n), a_idx]                                      # (n, V)
-        return own | (lent[:, :, None] & parts).any(axis=1)
+        return own | (lent[:, :, None] & self.parts[k]).any(axis=1)
 
     def patrol_moves(self, sim, memory, mask, patrolling):
         target = memory["target"]
@@ -219,13 +221,14 @@ class PARTPolicy(HeuristicPolicy):
             e_idx, a_idx = np.nonzero(need)
             allowed = self.allowed_vertices(sim, e_idx, a_idx)                # (n, V)
             here = self.spec.free_index[sim.pos[e_idx, a_idx]]
-            dist = self.nav.dist[here[:, None], self.vertex_free[None, :]]   # (n, V)
-            idle = sim.idle[e_idx]                                            # (n, V)
-            score = idle - 1e-3 * dist + 1e-6 * self.rng.random(idle.shape)
-            score = np.where(allowed & (dist > 0), score, -np.inf)
+            dist = self.dist_to_vertex[here]                                  # (n, V)
+            # highest idleness, then nearest, then a random order of the vertices drawn
+            # once per step (idleness differs by >= 1, 1e-3 * dist stays below 1)
+            score = sim.idle[e_idx] - 1e-3 * dist + 1e-6 * self.rng.random(dist.shape[1])
+            score[~allowed | (dist == 0)] = -np.inf                           # (n, V)
             best = np.argmax(score, axis=1)
-            target[e_idx, a_idx] = np.where(np.isfinite(score.max(axis=1)),
-                                            self.spec.vertex_cells[best], sim.pos[e_idx, a_idx])
+            found = score[np.arange(len(best)), best] > -np.inf
+            target[e_idx, a_idx] = np.where(found, self.spec.vertex_cells[best], sim.pos[e_idx, a_idx])
         target[~patrolling] = -1
         goal = np.where(patrolling, target, sim.pos)
         # inside its own part an agent keeps to the part; otherwise any station-free path
