@@ -82,3 +82,37 @@ def test_composite_masks_by_phase_and_mode(line_map):
     cfg = deterministic_config(max_agents=2, comm="none")
     message, move = composite_action_mask(spec, cfg, state, message_phase=False)
     assert list(np.flatnonzero(message[0, 0])) == [0] and np.array_equal(move, move_mask)
+
+
+def _mask_by_the_rule(spec, state):
+    """The mask rule written out agent by agent (reference for the vectorised one)."""
+    E, A = state.pos.shape
+    station = spec.kinds.ravel() == 2
+    mask = np.zeros((E, A, 5), dtype=bool)
+    for e in range(E):
+        for i in range(A):
+            if not state.active[e, i]:
+                mask[e, i, 4] = True
+                continue
+            for a in range(5):
+                t = spec.neighbour[state.pos[e, i], a]
+                taken = any(state.active[e, j] and state.pos[e, j] == t for j in range(A) if j != i)
+                mask[e, i, a] = a == 4 or (spec.move_ok[state.pos[e, i], a] and (not taken or station[t]))
+    return mask
+
+
+def test_vectorised_mask_matches_the_rule_on_crowded_random_states():
+    from patrolsb3.core import load_map, make_config
+    from patrolsb3.core.maps import STATION
+    assert STATION == 2
+    rng = np.random.default_rng(0)
+    for name in "ABCD":
+        spec = load_map(name)
+        state = reset_state(spec, make_config(name), 5, n_envs=200, seed=1)
+        state.pos[:] = spec.free_cells[rng.integers(0, len(spec.free_cells), state.pos.shape)]
+        for i in range(1, 5):   # crowd: each agent next to (or on) the one before it
+            state.pos[:, i] = spec.neighbour[state.pos[:, i - 1], rng.integers(0, 5, len(state.pos))]
+        state.status[rng.random(state.status.shape) < 0.2] = FAILED
+        mask = action_mask(spec, state)
+        assert np.array_equal(mask, _mask_by_the_rule(spec, state))
+        assert 0.2 < mask[..., :4].mean() < 0.9     # the states exercise both outcomes
