@@ -11,7 +11,7 @@ from pettingzoo.utils.conversions import parallel_to_aec
 from .core.config import ENV_VERSION, EnvConfig, make_config
 from .core.maps import STAY, load_map
 from .core.masks import composite_action_mask
-from .core.observe import VECTOR_SIZE, actor_observation, critic_state
+from .core.observe import actor_observation, critic_state, vector_size
 from .core.state import STATUS_NAMES, reset_state
 from .core.step import step as core_step
 
@@ -84,7 +84,7 @@ class PatrolParallelEnv(ParallelEnv):
         A = self.cfg.max_agents
         self._obs_space = spaces.Dict({
             "grid": spaces.Box(-1.0, 1.0, (2, H, W), np.float32),
-            "vector": spaces.Box(-1.0, 1.0, (VECTOR_SIZE,), np.float32),
+            "vector": spaces.Box(-1.0, 1.0, (vector_size(self.cfg),), np.float32),
             "critic": spaces.Box(0.0, 1.0, (3 * A,), np.float32),
         })
         self._act_space = spaces.MultiDiscrete([self.cfg.n_symbols, 5])

@@ -32,12 +32,12 @@ class ZooError(ValueError):
 
 
 def flat_observation(spec, cfg: EnvConfig, state, phase: int) -> np.ndarray:
-    """Observations in the training layout [grid (2*H*W), vector (15), critic (3*A)].
+    """Observations in the training layout [grid (2*H*W), vector (vector_size(cfg)), critic (3*A)].
 
     Returns:
-        (E * A, 2*H*W + 15 + 3*A) float32, row e * A + i = slot i of episode e.
+        (E * A, 2*H*W + vector_size(cfg) + 3*A) float32, row e * A + i = slot i of episode e.
     """
-    grid, vector = actor_observation(spec, cfg, state, phase=phase)        # (E,A,2,H,W), (E,A,8)
+    grid, vector = actor_observation(spec, cfg, state, phase=phase)        # (E,A,2,H,W), (E,A,vector_size)
     E, A = state.pos.shape
     critic = np.broadcast_to(critic_state(spec, cfg, state)[:, None, :], (E, A, 3 * A))
     flat = np.concatenate([grid.reshape(E, A, -1), vector, critic], axis=-1)
@@ -182,8 +182,8 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None) -> ZooPolicy:
     except Exception as exc:  # a corrupt or foreign file: say which one
         raise ZooError(f"{folder / 'model.zip'}: cannot be loaded as a {policy_class.__name__} "
                        f"({type(exc).__name__}: {exc})") from exc
-    from .core.observe import VECTOR_SIZE
-    expected = (2 * spec.kinds.size + VECTOR_SIZE + 3 * cfg.max_agents,)
+    from .core.observe import vector_size
+    expected = (2 * spec.kinds.size + vector_size(cfg) + 3 * cfg.max_agents,)
     if tuple(policy.observation_space.shape) != expected:
         raise ZooError(f"{folder / 'model.zip'}: the policy reads observations of shape "
                        f"{tuple(policy.observation_space.shape)}, this code makes {expected} "

@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from patrolsb3.core.observe import VECTOR_SIZE, actor_observation, critic_state
+from patrolsb3.core.observe import VECTOR_SIZE, actor_observation, critic_state, vector_size
 
 from conftest import deterministic_config, place
 
@@ -89,3 +89,21 @@ def test_critic_state_pads_empty_slots_with_the_station(observed):
     critic = critic_state(spec, cfg, state)
     assert critic.shape == (1, 9) and critic.dtype == np.float32
     assert list(critic[0]) == pytest.approx([0.5, 0.5, 4 / 6, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0])
+
+
+def test_local_idleness_copies_the_idleness_of_the_cell_each_move_leads_to(non_square_map):
+    spec = non_square_map            # "S..#..2" / ".#....." / "...#5.."
+    cfg = deterministic_config(max_agents=3, local_idleness=True)
+    state = place(spec, cfg, [(1, 4), (2, 6)], battery=[275.0, 550.0])
+    state.idle[0, spec.vertex_of_cell[0 * 7 + 4]] = 200.0     # above agent 0
+    state.visited[0, spec.vertex_of_cell[2 * 7 + 4]] = False  # below agent 0: never visited
+    grid, vector = actor_observation(spec, cfg, state)
+    assert vector.shape == (1, 3, vector_size(cfg)) == (1, 3, VECTOR_SIZE + 5)
+    np.testing.assert_allclose(vector[0, 0, VECTOR_SIZE:], [1 - math.exp(-1), 1, 0, 0, 0], rtol=1e-6)
+    assert list(vector[0, 1, VECTOR_SIZE:]) == [0, -1, 0, -1, 0]    # Down, Right leave the grid
+    assert not vector[0, 2, VECTOR_SIZE:].any()                      # absent slot
+    # the first VECTOR_SIZE values are those of the paper's layout, unchanged
+    _, plain = actor_observation(spec, deterministic_config(max_agents=3), state)
+    assert np.array_equal(vector[..., :VECTOR_SIZE], plain)
+    # the values are grid channel 1 next to the agent: Up from (1, 4) reads (0, 4)
+    assert vector[0, 0, VECTOR_SIZE] == grid[0, 0, 1, 0, 4]

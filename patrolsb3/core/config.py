@@ -61,6 +61,11 @@ class EnvConfig:
     c_pc: float = 1.0
     """Penalty to each agent in a collision event."""
 
+    local_idleness: bool = False
+    """OURS: append to the actor's vector the normalised idleness of the cell each move leads
+    to (5 values, see ``core/observe.py``), so that "go where it is most idle" is learnable from
+    the vector alone. Off for the paper's observation; the zoo's training turns it on."""
+
     n_symbols: int = 16
     """Size of the message alphabet (symbols 1..n_symbols; 0 is silence)."""
     comm: str = "learned"

@@ -25,6 +25,13 @@ The last three are OURS, not the paper's (its actor sees the graph and its batte
 compass to the station, so that the recharge decision is learnable within a CPU budget. Every
 learned variant gets them alike. They are 0 for inactive slots.
 
+With ``cfg.local_idleness`` (OURS, off by default) the vector goes on with the local
+idleness: for each move (Up, Down, Left, Right, Stay) the value channel 1 shows on the cell
+it leads to (f on a vertex, 0 on a station), -1 for a move off the map or into an obstacle.
+It is a copy of five grid values next to the agent, so that the patrol rule of CR ("go to the
+most idle neighbour") is learnable from the vector without the convolution first finding
+the agent on the grid.
+
 Critic state: for every slot its battery fraction, row / (H-1) and col / (W-1); an absent
 or failed slot is padded with battery 1 and the station's position (the paper's padding).
 """
@@ -39,7 +46,14 @@ from .reward import normalised_idleness
 from .state import ACTIVE, State
 
 VECTOR_SIZE = 15
-"""Length of the actor's vector observation."""
+"""Length of the actor's vector observation without the local idleness."""
+LOCAL_IDLENESS_SIZE = 5
+"""Values the local idleness adds (one per move)."""
+
+
+def vector_size(cfg: EnvConfig) -> int:
+    """Length of the actor's vector observation under ``cfg``."""
+    return VECTOR_SIZE + (LOCAL_IDLENESS_SIZE if cfg.local_idleness else 0)
 
 
 def home_features(spec: MapSpec, cfg: EnvConfig, state: State) -> np.ndarray:
@@ -80,7 +94,7 @@ def actor_observation(spec: MapSpec, cfg: EnvConfig, state: State, phase: int = 
         mask: (E, A, 5) move mask if already computed.
 
     Returns:
-        grid (E, A, 2, H, W) float32 and vector (E, A, VECTOR_SIZE) float32.
+        grid (E, A, 2, H, W) float32 and vector (E, A, vector_size(cfg)) float32.
     """
     E, A = state.pos.shape
     H, W = spec.shape
@@ -108,12 +122,18 @@ def actor_observation(spec: MapSpec, cfg: EnvConfig, state: State, phase: int = 
 
     if mask is None:
         mask = action_mask(spec, state)
-    vector = np.empty((E, A, VECTOR_SIZE), dtype=np.float32)
+    vector = np.empty((E, A, vector_size(cfg)), dtype=np.float32)
     vector[..., 0] = state.battery / cfg.b_max
     vector[..., 1:6] = mask
     vector[..., 6] = phase
     vector[..., 7] = active
-    vector[..., 8:] = home_features(spec, cfg, state)
+    vector[..., 8:VECTOR_SIZE] = home_features(spec, cfg, state)
+    if cfg.local_idleness:
+        target = spec.neighbour[state.pos]                                     # (E, A, 5)
+        local = np.take_along_axis(chan1, target.reshape(E, A * 5), axis=1).reshape(E, A, 5)
+        local[~spec.move_ok[state.pos]] = -1.0                                 # off map, obstacle
+        local[~active] = 0.0
+        vector[..., VECTOR_SIZE:] = local
     return grid.reshape(E, A, 2, H, W), vector
 
 
