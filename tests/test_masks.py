@@ -1,7 +1,7 @@
 """patrolsb3.core.masks: move masks on a non-square map, and the composite (message, move) masks."""
 import numpy as np
 
-from patrolsb3.core.masks import action_mask, composite_action_mask
+from patrolsb3.core.masks import action_mask, composite_action_mask, move_allowed
 from patrolsb3.core.state import FAILED, SWAPPING, reset_state
 
 from conftest import cell, deterministic_config, place
@@ -116,3 +116,9 @@ def test_vectorised_mask_matches_the_rule_on_crowded_random_states():
         mask = action_mask(spec, state)
         assert np.array_equal(mask, _mask_by_the_rule(spec, state))
         assert 0.2 < mask[..., :4].mean() < 0.9     # the states exercise both outcomes
+        for move in range(5):                        # the one-move check agrees with the mask
+            moves = np.full(state.pos.shape, move)
+            assert np.array_equal(move_allowed(spec, state, moves), mask[..., move])
+        moves = rng.integers(0, 5, state.pos.shape)
+        assert np.array_equal(move_allowed(spec, state, moves),
+                              np.take_along_axis(mask, moves[..., None], axis=-1)[..., 0])

@@ -13,6 +13,29 @@ def station_cells(spec: MapSpec) -> np.ndarray:
     return spec.kinds.ravel() == STATION
 
 
+def _blocked(spec: MapSpec, state: State, target: np.ndarray) -> np.ndarray:
+    """True where entering ``target`` is forbidden: off the grid or into an obstacle is
+    handled by ``spec.move_ok``; this is the dynamic part, a non-station cell held by another
+    active agent.
+
+    Args:
+        target: (E, A, ...) cells the slots would enter (their own cell for Stay).
+
+    Returns:
+        bool array shaped like ``target``.
+    """
+    pos, active = state.pos, state.active                      # (E, A)
+    E = pos.shape[0]
+    cells = spec.kinds.size
+    row = (np.arange(E) * cells).reshape((E,) + (1,) * (target.ndim - 1))
+    # occupancy grid: active agents per cell of each episode, flattened (E * H*W,)
+    occupancy = np.bincount((row.reshape(E, 1) + pos)[active], minlength=E * cells)
+    extra = (1,) * (target.ndim - 2)
+    own = active.reshape(active.shape + extra) & (target == pos.reshape(pos.shape + extra))
+    others = occupancy[row + target] - own                     # occupants other than the slot
+    return (others > 0) & ~station_cells(spec)[target]
+
+
 def action_mask(spec: MapSpec, state: State) -> np.ndarray:
     """Valid moves of every slot.
 
@@ -23,19 +46,28 @@ def action_mask(spec: MapSpec, state: State) -> np.ndarray:
     Returns:
         (E, A, 5) bool in action order Up, Down, Left, Right, Stay.
     """
-    pos, active = state.pos, state.active                      # (E, A)
-    E, A = pos.shape
+    pos = state.pos                                            # (E, A)
     target = spec.neighbour[pos]                               # (E, A, 5)
-    # occupancy grid: active agents per cell, minus the slot itself where it targets its own cell
-    cells = spec.kinds.size
-    flat = (np.arange(E)[:, None] * cells + pos)[active]
-    occupancy = np.bincount(flat, minlength=E * cells).reshape(E, cells)   # (E, H*W)
-    others = occupancy[np.arange(E)[:, None, None], target] - (active[..., None] & (target == pos[..., None]))
-    occupied = others > 0                                      # (E, A, 5)
-    mask = spec.move_ok[pos] & (~occupied | station_cells(spec)[target])
+    mask = spec.move_ok[pos] & ~_blocked(spec, state, target)
     mask[..., STAY] = True
-    mask[~active] = np.array([False, False, False, False, True])
+    mask[~state.active] = np.array([False, False, False, False, True])
     return mask
+
+
+def move_allowed(spec: MapSpec, state: State, moves: np.ndarray) -> np.ndarray:
+    """Whether each slot's chosen move is valid (the rule of :func:`action_mask`, evaluated
+    for one move per slot only).
+
+    Args:
+        moves: (E, A) int64 actions 0..4.
+
+    Returns:
+        (E, A) bool.
+    """
+    pos = state.pos
+    target = spec.neighbour[pos, moves]                        # (E, A)
+    ok = spec.move_ok[pos, moves] & ~_blocked(spec, state, target)
+    return np.where(state.active, ok | (moves == STAY), moves == STAY)
 
 
 def composite_action_mask(spec: MapSpec, cfg, state: State, message_phase: bool) -> tuple[np.ndarray, np.ndarray]:

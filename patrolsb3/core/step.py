@@ -30,7 +30,7 @@ import numpy as np
 
 from .config import EnvConfig
 from .maps import ACTION_NAMES, STAY, MapSpec
-from .masks import action_mask, station_cells
+from .masks import move_allowed, station_cells
 from .reward import (battery_reward, collision_reward, difference_reward, normalised_idleness,
                      team_patrol_reward)
 from .state import ACTIVE, FAILED, SWAPPING, State
@@ -83,8 +83,7 @@ def check_moves(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray) 
         bad = moves[(moves < 0) | (moves > STAY)][0]
         raise InvalidActionError(f"move {bad} outside 0..4 ({', '.join(ACTION_NAMES)})")
     moves = np.where(state.active, moves, STAY)
-    mask = action_mask(spec, state)
-    ok = np.take_along_axis(mask, moves[..., None], axis=-1)[..., 0]
+    ok = move_allowed(spec, state, moves)                                     # (E, A)
     if not ok.all():
         if cfg.invalid_action == "raise":
             e, a = np.argwhere(~ok)[0]

@@ -183,7 +183,9 @@ class PARTPolicy(HeuristicPolicy):
             self.parts[k, :k] = owner[None, :] == np.arange(k)[:, None]
             self.touch[k, :k, :k] = part_adjacency(self.spec, owner, k)
         self.vertex_free = self.spec.free_index[self.spec.vertex_cells]      # (V,)
-        self.dist_to_vertex = np.ascontiguousarray(self.nav.dist[:, self.vertex_free])  # (F, V)
+        to_vertex = self.nav.dist[:, self.vertex_free]                       # (F, V)
+        # (F, V) target-choice penalty: -1e-3 x path length, -inf for the cell the agent is on
+        self.vertex_penalty = np.where(to_vertex == 0, -np.inf, -1e-3 * to_vertex)
         # table 0: the patrol table; table 1 + k * A + a: paths inside part a of a team of k
         F = len(self.spec.free_cells)
         self.tables = np.zeros((1 + (A + 1) * A, F, F), dtype=np.int32)      # (T, F, F)
@@ -221,11 +223,12 @@ class PARTPolicy(HeuristicPolicy):
             e_idx, a_idx = np.nonzero(need)
             allowed = self.allowed_vertices(sim, e_idx, a_idx)                # (n, V)
             here = self.spec.free_index[sim.pos[e_idx, a_idx]]
-            dist = self.dist_to_vertex[here]                                  # (n, V)
             # highest idleness, then nearest, then a random order of the vertices drawn
             # once per step (idleness differs by >= 1, 1e-3 * dist stays below 1)
-            score = sim.idle[e_idx] - 1e-3 * dist + 1e-6 * self.rng.random(dist.shape[1])
-            score[~allowed | (dist == 0)] = -np.inf                           # (n, V)
+            score = sim.idle[e_idx]                                           # (n, V)
+            score += self.vertex_penalty[here]                                # nearest first, never here
+            score += 1e-6 * self.rng.random(score.shape[1])
+            np.copyto(score, -np.inf, where=~allowed)
             best = np.argmax(score, axis=1)
             found = score[np.arange(len(best)), best] > -np.inf
             target[e_idx, a_idx] = np.where(found, self.spec.vertex_cells[best], sim.pos[e_idx, a_idx])
