@@ -178,3 +178,32 @@ def test_refusals_name_the_problem(trained, tmp_path):
     (other / "model.zip").write_bytes(b"not a zip")
     with pytest.raises(zoo.ZooError, match="cannot be loaded"):
         zoo.load("ROOM", "rl-msg", zoo_dir=tmp_path / "zoo", spec=trained["map_file"])
+
+
+def test_the_local_idleness_layout_travels_with_the_checkpoint(trained, tmp_path):
+    # the vec env and the zoo build the same rows with the local idleness on
+    vec = make_vec_env(map="B", agents=[3], variant="rl-no-msg", seed=3, local_idleness=True)
+    obs = vec.reset()
+    env = vec.get_env(0)
+    assert obs.shape == (5, 2 * 12 * 12 + 20 + 15)
+    np.testing.assert_array_equal(zoo.flat_observation(env.spec_map, env.cfg, env.core_state, phase=1), obs)
+    # a run trained with it exports, loads and acts with it (its config.yml says so)
+    hp = {"n_steps": 16, "n_minibatches": 2, "n_envs": 2, "eval_freq": 0, "checkpoint_freq": 10**9,
+          "env": {"episode_steps": 20, "local_idleness": True},
+          "policy_kwargs": {"dense_sizes": [32, 16], "lstm_hidden_size": 8}}
+    run = train(map=str(trained["map_file"]), variant="rl-msg", timesteps=320, run_dir=tmp_path / "run",
+                hyperparams=hp, progress_bar=False)
+    zoo.export(run, zoo_dir=tmp_path / "zoo", budget={"cpu_hours": 0.001})
+    policy = zoo.load("ROOM", "rl-msg", zoo_dir=tmp_path / "zoo", spec=trained["map_file"])
+    assert policy.cfg.local_idleness
+    spec = load_map(trained["map_file"])
+    sim = reset_state(spec, make_config(None, episode_steps=50), [2, 3], n_envs=2, seed=1)
+    actions, _ = policy.predict(sim, state=None, episode_start=np.ones(2, bool))
+    assert actions.shape == (2, 5, 2)
+    # the same weights under a config without it are refused, naming the layout
+    path = tmp_path / "zoo" / "ROOM" / "rl-msg" / "config.yml"
+    config = yaml.safe_load(path.read_text())
+    config["env"]["local_idleness"] = False
+    path.write_text(yaml.safe_dump(config))
+    with pytest.raises(zoo.ZooError, match="another observation layout"):
+        zoo.load("ROOM", "rl-msg", zoo_dir=tmp_path / "zoo", spec=trained["map_file"])
