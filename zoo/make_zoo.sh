@@ -7,6 +7,20 @@
 # and D ran 2,700 s (788,480 steps, 0.21 CPU h each).
 # Stage 2 (patrol + recharge, from the stage-1 weights): 3,300 s for all six (A/rl-no-msg
 # started a minute later, 3,210 s).
+#
+# v3 (this session, map A only; B, C and D keep v2 below): zoo/train_two_stage.sh as it is now
+# (local idleness, c_d = 200), three runs side by side, stage 1 stopped by time (2,100 s),
+# stage 2 by SIGINT after 63 minutes; then exported with their CPU hours and evaluated
+# (deterministic 24 h into zoo/A, sampled 6 h as eval_sampled.json):
+#   STAGE1_OUT=runs/v3_stage1 STAGE1_RUNS="A:rl-msg A:rl-no-msg A:rl-intention" zoo/train_two_stage.sh 1 2100
+#   STAGE1_OUT=runs/v3_stage1 STAGE2_OUT=runs/v3_zoo ZOO_RUNS="A:rl-msg A:rl-no-msg A:rl-intention" \
+#     zoo/train_two_stage.sh 2 4200      # stopped at 63 min
+#   CPU hours (ps, both stages): rl-msg 0.99, rl-no-msg 0.99, rl-intention 1.01; export and
+#   evaluation as in the loop below with runs/v3_zoo and runs/v3_stage1 in place of runs/zoo
+#   and runs/stage1.
+#
+# v2 (B, C, D, and A's previous entries), with train_two_stage.sh before c_d and the local
+# idleness were added to it (git history, commit 0519976):
 set -euo pipefail
 zoo/train_two_stage.sh 1 2700
 zoo/train_two_stage.sh 2 3300
