@@ -41,6 +41,15 @@ def add_arguments(parser):
                              "exact protocol (episodes, steps, seed, tests, action mode)")
 
 
+def _clean_figures(summary: dict) -> str:
+    """MAX, AVG and collisions over episodes without a battery failure (the paper's tables),
+    or a note when every episode had one (the figures are NaN then)."""
+    if summary["max_idleness"]["mean"] != summary["max_idleness"]["mean"]:
+        return "MAX/AVG/col n/a (a battery failure in every episode)"
+    return (f"MAX {summary['max_idleness']['mean']:.1f} AVG {summary['avg_idleness']['mean']:.1f} "
+            f"col {summary['collisions']['mean']:.2f}")
+
+
 def run(args):
     import importlib
 
@@ -89,8 +98,7 @@ def run(args):
                                  seed=args.seed, progress=not args.no_progress,
                                  deterministic=not args.stochastic)
                 s = r["summary"]
-                print(f"map {r['map']} {name:>16} n={n}: MAX {s['max_idleness']['mean']:.1f} "
-                      f"AVG {s['avg_idleness']['mean']:.1f} col {s['collisions']['mean']:.2f} "
+                print(f"map {r['map']} {name:>16} n={n}: {_clean_figures(s)} "
                       f"BF {s['battery_failure_rate']['mean']:.3f} BLv {s['swap_battery_pct']['mean']:.1f}{source}",
                       flush=True)
                 results.append(r)
