@@ -1,6 +1,7 @@
 """``patrolsb3 compare``: every strategy x maps x team sizes -> the paper's tables, a markdown
 report and plots (see ``patrolsb3.report``). Zoo columns (INTENTION, NOMSG, MSG) are filled
 when ``patrolsb3.zoo`` has a model for the map, empty otherwise."""
+import math
 
 
 def parse_agents(text: str) -> list[int]:
@@ -44,7 +45,7 @@ def add_arguments(parser):
 def _clean_figures(summary: dict) -> str:
     """MAX, AVG and collisions over episodes without a battery failure (the paper's tables),
     or a note when every episode had one (the figures are NaN then)."""
-    if summary["max_idleness"]["mean"] != summary["max_idleness"]["mean"]:
+    if math.isnan(summary["max_idleness"]["mean"]):
         return "MAX/AVG/col n/a (a battery failure in every episode)"
     return (f"MAX {summary['max_idleness']['mean']:.1f} AVG {summary['avg_idleness']['mean']:.1f} "
             f"col {summary['collisions']['mean']:.2f}")

@@ -19,20 +19,17 @@ def _blocked(spec: MapSpec, state: State, target: np.ndarray) -> np.ndarray:
     active agent.
 
     Args:
-        target: (E, A, ...) cells the slots would enter (their own cell for Stay).
+        target: (E, A, K) cells the slots would enter (their own cell for Stay).
 
     Returns:
-        bool array shaped like ``target``.
+        (E, A, K) bool.
     """
     pos, active = state.pos, state.active                      # (E, A)
-    E = pos.shape[0]
     cells = spec.kinds.size
-    row = (np.arange(E) * cells).reshape((E,) + (1,) * (target.ndim - 1))
-    # occupancy grid: active agents per cell of each episode, flattened (E * H*W,)
-    occupancy = np.bincount((row.reshape(E, 1) + pos)[active], minlength=E * cells)
-    extra = (1,) * (target.ndim - 2)
-    own = active.reshape(active.shape + extra) & (target == pos.reshape(pos.shape + extra))
-    others = occupancy[row + target] - own                     # occupants other than the slot
+    row = np.arange(pos.shape[0])[:, None] * cells              # (E, 1) offset of each episode
+    occupancy = np.bincount((row + pos)[active], minlength=pos.shape[0] * cells)  # (E * H*W,)
+    own = active[..., None] & (target == pos[..., None])       # (E, A, K) the slot itself
+    others = occupancy[row[..., None] + target] - own          # occupants other than the slot
     return (others > 0) & ~station_cells(spec)[target]
 
 
@@ -66,7 +63,7 @@ def move_allowed(spec: MapSpec, state: State, moves: np.ndarray) -> np.ndarray:
     """
     pos = state.pos
     target = spec.neighbour[pos, moves]                        # (E, A)
-    ok = spec.move_ok[pos, moves] & ~_blocked(spec, state, target)
+    ok = spec.move_ok[pos, moves] & ~_blocked(spec, state, target[..., None])[..., 0]
     return np.where(state.active, ok | (moves == STAY), moves == STAY)
 
 
