@@ -43,6 +43,10 @@ def main(argv=None) -> int:
     except (MapError, ValueError, TypeError, FileNotFoundError) as exc:
         print(f"patrolsb3 {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:   # Ctrl-C / SIGINT: train has saved a checkpoint on the way out
+        hint = " (a checkpoint was saved; continue with --resume)" if args.command == "train" else ""
+        print(f"patrolsb3 {args.command}: interrupted{hint}", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

@@ -183,3 +183,26 @@ def test_init_from_errors(tmp_path):
     with pytest.raises(ValueError, match="cannot be loaded"):
         train(map=ROOM, timesteps=400, out=tmp_path, run_id="j", init_from=junk, progress_bar=False,
               hyperparams=tiny_hp())
+
+
+def test_interrupted_run_saves_a_checkpoint_and_the_cli_says_how_to_resume(tmp_path, monkeypatch, capsys):
+    original_learn = MaskableRecurrentPPO.learn
+
+    def learn_then_interrupt(self, total_timesteps, **kwargs):   # Ctrl-C after one rollout
+        original_learn(self, 400, **kwargs)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(MaskableRecurrentPPO, "learn", learn_then_interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        train(map=ROOM, timesteps=2000, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
+    run = tmp_path / "room" / "rl-msg" / "MaskableRecurrentPPO_seed0"
+    assert newest_checkpoint(run).name == "model_400_steps.zip" and not (run / "model.zip").exists()
+
+    from patrolsb3 import cli
+    from patrolsb3.commands import train as train_command
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(train_command, "run", interrupted)
+    assert cli.main(["train", "--map", "A"]) == 130
+    assert "interrupted (a checkpoint was saved; continue with --resume)" in capsys.readouterr().err
