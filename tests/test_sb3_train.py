@@ -154,6 +154,10 @@ def test_init_from_starts_a_new_run_from_the_weights(tmp_path):
         assert th.equal(value, src_weights[name]), name
     config = yaml.safe_load((run / "config.yml").read_text())
     assert config["init_from"] == {"path": str(source / "model.zip"), "timesteps": 400}
+    # a third stage started from the second counts both earlier runs
+    third = train(map=ROOM, timesteps=400, out=tmp_path, run_id="third", init_from=run, progress_bar=False,
+                  hyperparams=tiny_hp(curriculum=False))
+    assert yaml.safe_load((third / "config.yml").read_text())["init_from"]["timesteps"] == 800
     # a fresh run from random weights differs from the source
     fresh = train(map=ROOM, timesteps=400, out=tmp_path, run_id="fresh", seed=3, progress_bar=False,
                   hyperparams=tiny_hp(learning_rate=0.0))

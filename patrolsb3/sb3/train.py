@@ -141,6 +141,19 @@ def _check_resumable(run_dir: Path, config: dict) -> Path:
     return checkpoint
 
 
+def earlier_stages(model_path: Path) -> int:
+    """Agent-steps of the runs a checkpoint's own run was warm-started from (0 if none).
+
+    A run records ``init_from.timesteps`` in its config.yml, which already includes the stages
+    before it, so a chain of warm starts (stage 1 -> 2 -> 3 ...) adds up to the whole budget.
+    """
+    run_dir = model_path.parent.parent if model_path.parent.name == "checkpoints" else model_path.parent
+    config_file = run_dir / "config.yml"
+    if not config_file.is_file():
+        return 0
+    return int(((yaml.safe_load(config_file.read_text()) or {}).get("init_from") or {}).get("timesteps") or 0)
+
+
 def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]:
     """The policy weights of a previous model, to start a new run from them (``--init-from``).
 
@@ -151,7 +164,8 @@ def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]
         algo_class, policy_class: the classes of this run's algorithm.
 
     Returns:
-        (state_dict of the policy, {"path": str, "timesteps": agent-steps it was trained for}).
+        (state_dict of the policy, {"path": str, "timesteps": agent-steps it was trained for,
+        with every stage it was itself warm-started from}).
 
     Raises:
         FileNotFoundError: nothing loadable at that path.
@@ -166,7 +180,8 @@ def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]
     errors = []
     try:  # a whole model (checkpoint or run's model.zip)
         model = algo_class.load(str(path), device="cpu")
-        return model.policy.state_dict(), {"path": str(path), "timesteps": int(model.num_timesteps)}
+        return model.policy.state_dict(), {"path": str(path),
+                                           "timesteps": int(model.num_timesteps) + earlier_stages(path)}
     except Exception as exc:  # noqa: BLE001 - try the policy-only layout next
         errors.append(f"as a {algo_class.__name__}: {type(exc).__name__}: {exc}")
     try:  # a policy only (the zoo's model.zip)
