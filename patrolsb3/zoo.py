@@ -138,6 +138,53 @@ class ZooPolicy:
         return np.stack([symbols, moves], axis=-1).astype(np.int64), state
 
 
+def env_config(config: dict) -> EnvConfig:
+    """The env parameters a model was trained with, from its config.yml ``env`` section."""
+    env_fields = {f.name for f in dataclasses.fields(EnvConfig)}
+    return EnvConfig(**{k: (tuple(v) if isinstance(v, list) else v)
+                        for k, v in (config.get("env") or {}).items() if k in env_fields})
+
+
+def load_checkpoint(path, spec=None) -> ZooPolicy:
+    """A training checkpoint of ``patrolsb3 train`` as a ready policy, like :func:`load`.
+
+    Args:
+        path: ``<run>/checkpoints/model_<steps>_steps.zip`` or ``<run>/model.zip``; the run's
+            config.yml (next to it, or one folder up) gives the map and the env parameters.
+        spec: the map to act on (default: the training map); must match its size.
+
+    Raises:
+        ZooError: no such file, no config.yml beside it, a file that is not a model of the run's
+            algorithm, or a map of another size.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ZooError(f"no checkpoint at {path}")
+    run_dir = path.parent.parent if path.parent.name == "checkpoints" else path.parent
+    if not (run_dir / "config.yml").is_file():
+        raise ZooError(f"{path}: no config.yml in {run_dir}; give a checkpoint inside a run folder of "
+                       f"'patrolsb3 train'")
+    config = yaml.safe_load((run_dir / "config.yml").read_text()) or {}
+    if spec is None:   # the training map file if it is still there, else the map by name
+        source = config.get("map_source")
+        spec = source if source and Path(source).is_file() else config["map"]
+    spec = load_map(spec)
+    if tuple(config.get("map_shape", spec.shape)) != tuple(spec.shape):
+        raise ZooError(f"{path}: trained on a {tuple(config['map_shape'])} map, cannot act on "
+                       f"{spec.name} of size {spec.shape}")
+    import torch
+    torch.set_num_threads(1)
+    from .sb3.algorithms import get_algorithm
+    algo_class, _ = get_algorithm(config.get("algo", "MaskableRecurrentPPO")).classes()
+    try:
+        model = algo_class.load(str(path), device="cpu")
+    except Exception as exc:  # a corrupt or foreign file: say which one
+        raise ZooError(f"{path}: cannot be loaded as a {algo_class.__name__} checkpoint "
+                       f"({type(exc).__name__}: {exc})") from exc
+    info = {"path": str(path), "config": config, "timesteps": int(model.num_timesteps)}
+    return ZooPolicy(model.policy, spec, env_config(config), info)
+
+
 def load(map_name: str, variant: str, zoo_dir=None, spec=None) -> ZooPolicy:
     """Load a zoo model ready to act: ``patrolsb3.zoo.load("A", "rl-msg")``.
 
@@ -169,10 +216,7 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None) -> ZooPolicy:
     if trained_shape != tuple(spec.shape):
         raise ZooError(f"{folder}: trained on a {trained_shape} map, cannot act on "
                        f"{spec.name} of size {spec.shape}")
-    env_fields = {f.name for f in dataclasses.fields(EnvConfig)}
-    env_cfg = {k: (tuple(v) if isinstance(v, list) else v)
-               for k, v in (config.get("env") or {}).items() if k in env_fields}
-    cfg = EnvConfig(**env_cfg)
+    cfg = env_config(config)
     import torch
     torch.set_num_threads(1)     # small networks: one thread is fastest, and several oversubscribe
     from .sb3.algorithms import get_algorithm

@@ -10,7 +10,7 @@
 # ablation table (ABLATIONS="" runs none). Logs go to runs/logs/, run folders to ZOO_OUT
 # (default runs/zoo) and runs/ablation. INIT_FROM (optional, e.g.
 # "runs/stage1/{map}/{variant}/MaskableRecurrentPPO_seed0") starts each new zoo run from the
-# weights of that run ({map} and {variant} filled in; see zoo/train_two_stage.sh).
+# weights of that run ({map} and {variant} filled in; see zoo/train_stages.sh).
 set -uo pipefail
 SECONDS_PER_CALL=${1:?usage: zoo/train_parallel.sh SECONDS [--resume]}
 RESUME=${2:-}

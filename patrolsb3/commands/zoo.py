@@ -1,6 +1,8 @@
 """``patrolsb3 zoo list``: every zoo entry with its budget, date, env version and headline
-figures; ``patrolsb3 zoo show MAP VARIANT``: one entry's config and evaluation."""
+figures; ``patrolsb3 zoo show MAP VARIANT``: one entry's config and evaluation; ``patrolsb3 zoo
+export RUN``: a run into the zoo; ``patrolsb3 zoo validate RUN``: rank a run's checkpoints."""
 import json
+import math
 
 
 def add_arguments(parser):
@@ -24,6 +26,14 @@ def add_arguments(parser):
     p_export.add_argument("--stochastic", action="store_true",
                           help="evaluate with sampled actions (default: the most likely legal action)")
     p_export.add_argument("--no-eval", action="store_true", help="copy only, no eval.json")
+    p_val = sub.add_parser("validate", help="evaluate every checkpoint of a run on a short greedy protocol "
+                                            "(its own seed) and rank them: fewest battery failures, then AVG^h")
+    p_val.add_argument("run_dir", help="run folder of 'patrolsb3 train'")
+    p_val.add_argument("--agents", default="1,3,5", help="team sizes (default 1,3,5)")
+    p_val.add_argument("--episodes", type=int, default=4, help="episodes per team size (default 4)")
+    p_val.add_argument("--steps", type=int, default=3000, help="steps per episode (default 3000 = 5 h)")
+    p_val.add_argument("--seed", type=int, default=7, help="simulator seed (default 7; the zoo's eval uses 0)")
+    p_val.add_argument("--last", type=int, default=None, help="only the newest N checkpoints")
 
 
 def headline(entry: dict) -> str:
@@ -44,6 +54,8 @@ def run(args):
     from ..zoo import entry_dir, list_entries, read_entry
     if args.zoo_command == "export":
         return export_and_evaluate(args)
+    if args.zoo_command == "validate":
+        return validate_checkpoints(args)
     if args.zoo_command == "show":
         print(json.dumps(read_entry(entry_dir(args.map, args.variant, args.zoo_dir)), indent=2, default=str))
         return 0
@@ -71,4 +83,27 @@ def export_and_evaluate(args) -> int:
         path = write_eval(folder, episodes=args.episodes, steps=args.steps, seed=args.seed,
                           deterministic=not args.stochastic)
         print(f"evaluation written to {path}")
+    return 0
+
+
+def validate_checkpoints(args) -> int:
+    """``patrolsb3 zoo validate``: one line per checkpoint, then the best by failures and AVG^h."""
+    from ..checkpoints import rank, run_checkpoints, validate
+    try:
+        sizes = tuple(int(n) for n in str(args.agents).split(","))
+    except ValueError:
+        raise ValueError(f"--agents {args.agents!r}: give team sizes like 1,3,5") from None
+    paths = run_checkpoints(args.run_dir)
+    if args.last:
+        paths = paths[-args.last:]
+    print(f"{len(paths)} checkpoints; greedy, {args.episodes} episodes x {args.steps} steps for n = "
+          f"{','.join(map(str, sizes))}, seed {args.seed}")
+    rows = []
+    for path in paths:
+        row = validate(path, team_sizes=sizes, episodes=args.episodes, steps=args.steps, seed=args.seed)
+        rows.append(row)
+        swap = "-" if math.isnan(row["swap_battery"]) else f"{100 * row['swap_battery']:.0f} %"
+        print(f"{row['timesteps']:>10,} steps  failures/episode {row['failures']:.2f}  BF rate "
+              f"{row['bf_rate']:.2f}  AVG^h {row['avg_idleness']:.1f}  battery at swap {swap}  {path}", flush=True)
+    print(f"best: {rank(rows)[0]['checkpoint']}")
     return 0
