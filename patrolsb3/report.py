@@ -77,6 +77,20 @@ def _table_rows(results: list[dict], map_name: str, metric: str, columns) -> lis
     return rows
 
 
+def clean_figures(summary: dict, precision: int = 1) -> str:
+    """MAX, AVG and collisions over episodes without a battery failure (the paper's tables) as
+    text, or a note when every episode had one (those figures are NaN then).
+
+    Args:
+        summary: an ``evaluate()``-style summary (``{"max_idleness": {"mean": ...}, ...}``).
+        precision: decimals of MAX and AVG; collisions get one more.
+    """
+    if math.isnan(summary["max_idleness"]["mean"]):
+        return "MAX/AVG/col n/a (a battery failure in every episode)"
+    return (f"MAX {summary['max_idleness']['mean']:.{precision}f} AVG {summary['avg_idleness']['mean']:.{precision}f} "
+            f"col {summary['collisions']['mean']:.{precision + 1}f}")
+
+
 def write_compare(results: list[dict], out_dir, plots: bool = True, learning_curves=None) -> list[Path]:
     """Write every table, the report and the plots of a comparison.
 

@@ -154,12 +154,3 @@ def test_summary_also_averages_over_every_episode():
     s = summarize(per_episode, tests=2)
     assert s["avg_idleness"]["tests"] == [2.0, 4.0]              # clean episodes only
     assert s["avg_idleness_all"]["tests"] == [6.0, 12.0]         # every episode
-
-
-def test_compare_line_says_when_every_episode_had_a_battery_failure():
-    from patrolsb3.commands.compare import _clean_figures
-    nan = float("nan")
-    every = {"max_idleness": {"mean": nan}, "avg_idleness": {"mean": nan}, "collisions": {"mean": nan}}
-    assert _clean_figures(every) == "MAX/AVG/col n/a (a battery failure in every episode)"
-    some = {"max_idleness": {"mean": 267.1}, "avg_idleness": {"mean": 58.0}, "collisions": {"mean": 422.0}}
-    assert _clean_figures(some) == "MAX 267.1 AVG 58.0 col 422.00"

@@ -90,3 +90,13 @@ def test_curve_summary_quarters(tmp_path):
     empty.write_text(rows[0] + "\n")
     with pytest.raises(ValueError, match="no finished training episode"):
         curve_summary(empty)
+
+
+def test_clean_figures_say_when_every_episode_had_a_battery_failure():
+    from patrolsb3.report import clean_figures
+    nan = float("nan")
+    every = {"max_idleness": {"mean": nan}, "avg_idleness": {"mean": nan}, "collisions": {"mean": nan}}
+    assert clean_figures(every) == "MAX/AVG/col n/a (a battery failure in every episode)"
+    some = {"max_idleness": {"mean": 267.1}, "avg_idleness": {"mean": 58.0}, "collisions": {"mean": 422.0}}
+    assert clean_figures(some) == "MAX 267.1 AVG 58.0 col 422.00"
+

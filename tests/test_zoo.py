@@ -207,3 +207,20 @@ def test_the_local_idleness_layout_travels_with_the_checkpoint(trained, tmp_path
     path.write_text(yaml.safe_dump(config))
     with pytest.raises(zoo.ZooError, match="another observation layout"):
         zoo.load("ROOM", "rl-msg", zoo_dir=tmp_path / "zoo", spec=trained["map_file"])
+
+
+def test_zoo_list_prints_budget_and_headline_figures(trained, capsys):
+    from patrolsb3 import cli
+    from patrolsb3.commands.zoo import headline
+    assert cli.main(["zoo", "list", "--zoo-dir", str(trained["root"] / "zoo")]) == 0
+    out = capsys.readouterr().out
+    assert "room/rl-msg" in out and "0.001 CPU h" in out
+    ok = {"max_idleness": {"mean": 12.4}, "avg_idleness": {"mean": 5.2}, "collisions": {"mean": 1.54},
+          "battery_failure_rate": {"mean": 0.0}}
+    failed = {**ok, "max_idleness": {"mean": float("nan")}, "avg_idleness": {"mean": float("nan")},
+              "battery_failure_rate": {"mean": 1.0}}
+    entry = {"eval": {"episodes": 2, "steps": 30, "results": [{"n_agents": 1, "summary": ok},
+                                                               {"n_agents": 2, "summary": failed}]}}
+    text = headline(entry)
+    assert "n=1: MAX 12 AVG 5 col 1.5 BF 0.00" in text
+    assert "n=2: MAX/AVG/col n/a (a battery failure in every episode) BF 1.00" in text and "nan" not in text

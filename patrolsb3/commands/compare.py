@@ -1,7 +1,6 @@
 """``patrolsb3 compare``: every strategy x maps x team sizes -> the paper's tables, a markdown
 report and plots (see ``patrolsb3.report``). Zoo columns (INTENTION, NOMSG, MSG) are filled
 when ``patrolsb3.zoo`` has a model for the map, empty otherwise."""
-import math
 
 
 def parse_agents(text: str) -> list[int]:
@@ -42,20 +41,11 @@ def add_arguments(parser):
                              "exact protocol (episodes, steps, seed, tests, action mode)")
 
 
-def _clean_figures(summary: dict) -> str:
-    """MAX, AVG and collisions over episodes without a battery failure (the paper's tables),
-    or a note when every episode had one (the figures are NaN then)."""
-    if math.isnan(summary["max_idleness"]["mean"]):
-        return "MAX/AVG/col n/a (a battery failure in every episode)"
-    return (f"MAX {summary['max_idleness']['mean']:.1f} AVG {summary['avg_idleness']['mean']:.1f} "
-            f"col {summary['collisions']['mean']:.2f}")
-
-
 def run(args):
     import importlib
 
     from ..evaluate import evaluate
-    from ..report import EXTRA_COLUMNS, ZOO_COLUMNS, write_compare
+    from ..report import EXTRA_COLUMNS, ZOO_COLUMNS, clean_figures, write_compare
     if args.protocol == "paper":
         args.tests, args.episodes, args.steps = 10, 100, 14400
     maps = [m.strip() for m in args.maps.split(",") if m.strip()]
@@ -99,7 +89,7 @@ def run(args):
                                  seed=args.seed, progress=not args.no_progress,
                                  deterministic=not args.stochastic)
                 s = r["summary"]
-                print(f"map {r['map']} {name:>16} n={n}: {_clean_figures(s)} "
+                print(f"map {r['map']} {name:>16} n={n}: {clean_figures(s)} "
                       f"BF {s['battery_failure_rate']['mean']:.3f} BLv {s['swap_battery_pct']['mean']:.1f}{source}",
                       flush=True)
                 results.append(r)

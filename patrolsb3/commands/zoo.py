@@ -38,12 +38,12 @@ def add_arguments(parser):
 
 def headline(entry: dict) -> str:
     """Short text of an entry's evaluation: MAX and AVG idleness, collisions, BF rate per n."""
+    from ..report import clean_figures
     ev = entry.get("eval") or {}
     parts = []
     for row in ev.get("results", []):
         s = row["summary"]
-        parts.append(f"n={row['n_agents']}: MAX {s['max_idleness']['mean']:.0f} "
-                     f"AVG {s['avg_idleness']['mean']:.0f} col {s['collisions']['mean']:.1f} "
+        parts.append(f"n={row['n_agents']}: {clean_figures(s, precision=0)} "
                      f"BF {s['battery_failure_rate']['mean']:.2f}")
     if not parts:
         return "not evaluated"
