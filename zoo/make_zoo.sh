@@ -8,22 +8,37 @@
 # Stage 2 (patrol + recharge, from the stage-1 weights): 3,300 s for all six (A/rl-no-msg
 # started a minute later, 3,210 s).
 #
-# v3 (this session, map A only; B, C and D keep v2 below): zoo/train_two_stage.sh as it is now
+# v4 (map A only; B, C and D keep v2 below): the v3 entries below, then stage 3 of
+# zoo/train_stages.sh (the recharge drill), three runs side by side, started from the v3 zoo
+# entries (zoo/A/<variant>, now kept as curve_stage2.csv / command_stage2.txt) and run to
+# 614,400 agent-steps, then resumed to 1,228,800 (command.txt has both calls; rl-no-msg's
+# first 613,040 steps ran as a trial, runs/drill/.../d1_cd200, with the same settings, and its
+# folder was moved into runs/v4_stage3), every checkpoint from 614,400 on validated with
+#   patrolsb3 zoo validate runs/v4_stage3/A/<variant>/MaskableRecurrentPPO_seed0
+# (4 episodes x 3,000 steps for n = 1, 3, 5, seed 7) and the best exported:
+#   patrolsb3 zoo export runs/v4_stage3/A/<variant>/MaskableRecurrentPPO_seed0 \
+#     --checkpoint .../checkpoints/model_<best>_steps.zip --cpu-hours <v3 + stage 3> \
+#     --episodes 10 --steps 14400 --seed 0
+# with the v3 curves and commands copied beside (curve_stage1.csv, curve_stage2.csv, ...);
+# the checkpoints, CPU hours and validation figures are in zoo/README.md; then the sampled
+# evaluation and the comparisons as at the end of this script.
+#
+# v3 (map A; replaced by v4): zoo/train_stages.sh stages 1 and 2
 # (local idleness, c_d = 200), three runs side by side, stage 1 stopped by time (2,100 s),
 # stage 2 by SIGINT after 63 minutes; then exported with their CPU hours and evaluated
 # (deterministic 24 h into zoo/A, sampled 6 h as eval_sampled.json):
-#   STAGE1_OUT=runs/v3_stage1 STAGE1_RUNS="A:rl-msg A:rl-no-msg A:rl-intention" zoo/train_two_stage.sh 1 2100
+#   STAGE1_OUT=runs/v3_stage1 STAGE1_RUNS="A:rl-msg A:rl-no-msg A:rl-intention" zoo/train_stages.sh 1 2100
 #   STAGE1_OUT=runs/v3_stage1 STAGE2_OUT=runs/v3_zoo ZOO_RUNS="A:rl-msg A:rl-no-msg A:rl-intention" \
-#     zoo/train_two_stage.sh 2 4200      # stopped at 63 min
+#     zoo/train_stages.sh 2 4200      # stopped at 63 min
 #   CPU hours (ps, both stages): rl-msg 0.99, rl-no-msg 0.99, rl-intention 1.01; export and
 #   evaluation as in the loop below with runs/v3_zoo and runs/v3_stage1 in place of runs/zoo
 #   and runs/stage1.
 #
-# v2 (B, C, D, and A's previous entries), with train_two_stage.sh before c_d and the local
-# idleness were added to it (git history, commit 0519976):
+# v2 (B, C, D, and A's earlier entries), with the script (then train_two_stage.sh) before c_d
+# and the local idleness were added to it (git history, commit 0519976):
 set -euo pipefail
-zoo/train_two_stage.sh 1 2700
-zoo/train_two_stage.sh 2 3300
+zoo/train_stages.sh 1 2700
+zoo/train_stages.sh 2 3300
 # Export (policy only) with the CPU hours of both stages (CPU_HOURS: "A:rl-msg=0.8 ..."), the
 # stage-1 learning curve and command beside the stage-2 ones, and eval.json (10 episodes x
 # 14,400 steps for n = 1..5, seed 0, deterministic actions).

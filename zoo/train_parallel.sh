@@ -38,7 +38,7 @@ launch() {  # out map variant run_id seed settings...
   local out=$1 map=$2 variant=$3 run_id=$4 seed=$5; shift 5
   nohup timeout -s INT "$SECONDS_PER_CALL" patrolsb3 train --map "$map" --variant "$variant" \
     --timesteps "$TIMESTEPS" --out "$out" --run-id "$run_id" --seed "$seed" $RESUME $(init_from "$out" "$map" "$variant") --no-progress \
-    --checkpoint-freq 250000 --eval-freq 0 --set $* \
+    --checkpoint-freq "${CHECKPOINT_FREQ:-250000}" --eval-freq 0 --set $* \
     >> "runs/logs/${out##*/}_${map}_${variant}_${run_id}.log" 2>&1 &
 }
 

@@ -5,7 +5,6 @@
 #   zoo/train_stages.sh 1 SECONDS [--resume]   # stage 1: patrol only, STAGE1_OUT (runs/stage1)
 #   zoo/train_stages.sh 2 SECONDS [--resume]   # stage 2: patrol + recharge, STAGE2_OUT (runs/zoo)
 #   zoo/train_stages.sh 3 SECONDS [--resume]   # stage 3: recharge drill, STAGE3_OUT (runs/stage3)
-#   zoo/train_stages.sh 4 SECONDS [--resume]   # stage 4: recharge timing, STAGE4_OUT (runs/stage4)
 #
 # Each stage after the first starts from the weights of the stage before it (its run folder:
 # model.zip, or the newest checkpoint of a run stopped by time).
@@ -14,12 +13,13 @@
 # starting batteries of 15-100 %, long enough that each agent needs two or three swaps and
 # swapping early costs patrol time. Stage 3 is a drill of the recharge itself: 400-step episodes
 # whose batteries start at 5-40 %, so that most of what an agent lives through is the trip to
-# the station (stage 2 alone left agents patrolling until their battery ran out). Stage 4 is
-# stage 2 again, from the drilled weights, to learn not to swap too early. STAGE1_RUNS /
-# ZOO_RUNS pick the runs (map:variant); the shared settings below apply to every variant alike.
+# the station (stage 2 alone left agents patrolling until their battery ran out); choose its
+# checkpoint with `patrolsb3 zoo validate` (a later stage back on long episodes erased the
+# recharge again: zoo/README.md). STAGE1_RUNS / ZOO_RUNS pick the runs (map:variant); the
+# shared settings below apply to every variant alike.
 set -euo pipefail
-STAGE=${1:?usage: zoo/train_stages.sh 1|2|3|4 SECONDS [--resume]}
-SECONDS_PER_CALL=${2:?usage: zoo/train_stages.sh 1|2|3|4 SECONDS [--resume]}
+STAGE=${1:?usage: zoo/train_stages.sh 1|2|3 SECONDS [--resume]}
+SECONDS_PER_CALL=${2:?usage: zoo/train_stages.sh 1|2|3 SECONDS [--resume]}
 RESUME=${3:-}
 # env.local_idleness and env.c_d (the difference reward's weight, paper 50 / 5 = 10) are this
 # zoo's changes to the observation and the reward scale; zoo/README.md says why
@@ -33,14 +33,10 @@ case "$STAGE" in
        INIT_FROM="${STAGE1_OUT:-runs/stage1}/{map}/{variant}/MaskableRecurrentPPO_seed0" \
        ZOO_RUNS=${ZOO_RUNS:-"A:rl-msg A:rl-no-msg A:rl-intention B:rl-msg C:rl-msg D:rl-msg"} \
        ZOO_SET="env.episode_steps=1500 env.init_battery=[0.15,1.0] $SHARED learning_rate=3e-4 curriculum=false" ;;
-  3) export ZOO_OUT=${STAGE3_OUT:-runs/stage3} TIMESTEPS=${TIMESTEPS:-614400} \
+  3) export ZOO_OUT=${STAGE3_OUT:-runs/stage3} TIMESTEPS=${TIMESTEPS:-1228800} CHECKPOINT_FREQ=100000 \
        INIT_FROM="${STAGE2_OUT:-runs/zoo}/{map}/{variant}/MaskableRecurrentPPO_seed0" \
        ZOO_RUNS=${ZOO_RUNS:-"A:rl-msg A:rl-no-msg A:rl-intention"} \
        ZOO_SET="env.episode_steps=400 env.init_battery=[0.05,0.4] $SHARED learning_rate=3e-4 curriculum=false" ;;
-  4) export ZOO_OUT=${STAGE4_OUT:-runs/stage4} TIMESTEPS=${TIMESTEPS:-3000000} \
-       INIT_FROM="${STAGE3_OUT:-runs/stage3}/{map}/{variant}/MaskableRecurrentPPO_seed0" \
-       ZOO_RUNS=${ZOO_RUNS:-"A:rl-msg A:rl-no-msg A:rl-intention"} \
-       ZOO_SET="env.episode_steps=1500 env.init_battery=[0.15,1.0] $SHARED learning_rate=3e-4 curriculum=false" ;;
-  *) echo "stage must be 1, 2, 3 or 4" >&2; exit 2 ;;
+  *) echo "stage must be 1, 2 or 3" >&2; exit 2 ;;
 esac
 exec zoo/train_parallel.sh "$SECONDS_PER_CALL" $RESUME
