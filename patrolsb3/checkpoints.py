@@ -8,12 +8,9 @@ ranked: fewest battery failures first, then the lowest AVG^h.
 """
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import numpy as np
-
-CHECKPOINT_RE = re.compile(r"model_(\d+)_steps\.zip$")
 
 
 def run_checkpoints(run_dir) -> list[Path]:
@@ -22,10 +19,9 @@ def run_checkpoints(run_dir) -> list[Path]:
     Raises:
         FileNotFoundError: a folder with no checkpoint and no model.zip.
     """
+    from .sb3.train import checkpoints_by_steps
     run_dir = Path(run_dir)
-    found = sorted((int(m.group(1)), p) for p in (run_dir / "checkpoints").glob("model_*_steps.zip")
-                   if (m := CHECKPOINT_RE.search(p.name)))
-    paths = [p for _, p in found]
+    paths = checkpoints_by_steps(run_dir)
     if (run_dir / "model.zip").is_file():
         paths.append(run_dir / "model.zip")
     if not paths:
@@ -49,13 +45,10 @@ def validate(path, team_sizes=(1, 3, 5), episodes: int = 4, steps: int = 3000, s
         episode), "bf_rate" (share of episodes with one), "avg_idleness" (AVG^h over every
         episode, failed ones included), "swap_battery" (mean battery fraction at a swap)}.
     """
-    from .core.config import make_config
     from .evaluate import run_episodes
-    from .zoo import load_checkpoint
+    from .zoo import evaluation_config, load_checkpoint
     policy = load_checkpoint(path)
-    # the evaluation's env (the paper's values for the map), as patrolsb3.zoo.write_eval builds it
-    cfg = make_config(policy.info["config"].get("map"), max_agents=policy.cfg.max_agents,
-                      episode_steps=int(steps), invalid_action="raise")
+    cfg = evaluation_config(policy, steps)
     team = np.repeat(np.asarray(team_sizes, dtype=np.int64), episodes)          # (E,)
     result = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, deterministic=True)
     swap = result["swap_battery"]

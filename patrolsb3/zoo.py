@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from .core.config import ENV_VERSION, EnvConfig
-from .core.maps import load_map
+from .core.config import ENV_VERSION, EnvConfig, make_config
+from .core.maps import MapSpec, load_map
 from .core.masks import composite_action_mask
 from .core.observe import actor_observation, critic_state
 
@@ -145,6 +145,27 @@ def env_config(config: dict) -> EnvConfig:
                         for k, v in (config.get("env") or {}).items() if k in env_fields})
 
 
+def checked_map(config: dict, spec, where) -> MapSpec:
+    """Load the map a model should act on and refuse one of another size than it was trained on.
+
+    Raises:
+        ZooError: names ``where`` (the model), the trained size and the map's.
+    """
+    spec = load_map(spec)
+    trained_shape = tuple(config.get("map_shape", ()))
+    if trained_shape != tuple(spec.shape):
+        raise ZooError(f"{where}: trained on a {trained_shape} map, cannot act on "
+                       f"{spec.name} of size {spec.shape}")
+    return spec
+
+
+def evaluation_config(policy: ZooPolicy, steps: int) -> EnvConfig:
+    """The env a model is evaluated in: the paper's values for its training map (not the
+    training settings), its number of slots, ``steps`` per episode, invalid actions refused."""
+    return make_config(policy.info["config"].get("map"), max_agents=policy.cfg.max_agents,
+                       episode_steps=int(steps), invalid_action="raise")
+
+
 def load_checkpoint(path, spec=None) -> ZooPolicy:
     """A training checkpoint of ``patrolsb3 train`` as a ready policy, like :func:`load`.
 
@@ -160,7 +181,8 @@ def load_checkpoint(path, spec=None) -> ZooPolicy:
     path = Path(path)
     if not path.is_file():
         raise ZooError(f"no checkpoint at {path}")
-    run_dir = path.parent.parent if path.parent.name == "checkpoints" else path.parent
+    from .sb3.train import run_folder_of
+    run_dir = run_folder_of(path)
     if not (run_dir / "config.yml").is_file():
         raise ZooError(f"{path}: no config.yml in {run_dir}; give a checkpoint inside a run folder of "
                        f"'patrolsb3 train'")
@@ -168,10 +190,7 @@ def load_checkpoint(path, spec=None) -> ZooPolicy:
     if spec is None:   # the training map file if it is still there, else the map by name
         source = config.get("map_source")
         spec = source if source and Path(source).is_file() else config["map"]
-    spec = load_map(spec)
-    if tuple(config.get("map_shape", spec.shape)) != tuple(spec.shape):
-        raise ZooError(f"{path}: trained on a {tuple(config['map_shape'])} map, cannot act on "
-                       f"{spec.name} of size {spec.shape}")
+    spec = checked_map(config, spec, path)
     import torch
     torch.set_num_threads(1)
     from .sb3.algorithms import get_algorithm
@@ -211,11 +230,7 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None) -> ZooPolicy:
     if version != ENV_VERSION:
         raise ZooError(f"{folder}: trained for env version {version!r}, this code is {ENV_VERSION!r}; "
                        f"retrain it or use a matching patrolsb3 release")
-    spec = load_map(spec if spec is not None else map_name)
-    trained_shape = tuple(config.get("map_shape", ()))
-    if trained_shape != tuple(spec.shape):
-        raise ZooError(f"{folder}: trained on a {trained_shape} map, cannot act on "
-                       f"{spec.name} of size {spec.shape}")
+    spec = checked_map(config, spec if spec is not None else map_name, folder)
     cfg = env_config(config)
     import torch
     torch.set_num_threads(1)     # small networks: one thread is fastest, and several oversubscribe
@@ -306,14 +321,13 @@ def write_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0, te
         Path of eval.json: {"map", "strategy", "episodes", "tests", "steps", "seed", "deterministic",
         "results": [evaluate()-style dict per team size]}.
     """
-    from .core.config import make_config
     from .core.metrics import idleness_lower_bounds
     from .evaluate import run_episodes, summarize
     folder = Path(folder)
     config = read_entry(folder)["config"]
     policy = load(config["map"], config["variant"], zoo_dir=folder.parent.parent)
     max_agents = policy.cfg.max_agents
-    cfg = make_config(config["map"], max_agents=max_agents, episode_steps=steps, invalid_action="raise")
+    cfg = evaluation_config(policy, steps)
     per_size = episodes * tests
     team = np.repeat(np.arange(1, max_agents + 1), per_size)                # (max_agents * per_size,)
     per_episode = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, progress=progress,

@@ -45,11 +45,23 @@ def curriculum_teams(n_envs: int, max_agents: int, curriculum=CURRICULUM) -> lis
     return [[min(int(row[i]), max_agents) for i in index] for row in curriculum]
 
 
+def checkpoints_by_steps(run_dir) -> list[Path]:
+    """The checkpoints ``run_dir/checkpoints/model_<steps>_steps.zip``, fewest steps first."""
+    found = sorted((int(m.group(1)), p) for p in (Path(run_dir) / "checkpoints").glob("model_*_steps.zip")
+                   if (m := CHECKPOINT_RE.search(p.name)))
+    return [p for _, p in found]
+
+
 def newest_checkpoint(run_dir: Path) -> Path | None:
     """The checkpoint of ``run_dir/checkpoints`` with the most timesteps, or None."""
-    found = [(int(m.group(1)), p) for p in (run_dir / "checkpoints").glob("model_*_steps.zip")
-             if (m := CHECKPOINT_RE.search(p.name))]
-    return max(found)[1] if found else None
+    found = checkpoints_by_steps(run_dir)
+    return found[-1] if found else None
+
+
+def run_folder_of(model_path: Path) -> Path:
+    """The run folder of a model file: ``<run>/checkpoints/model_<steps>_steps.zip`` or ``<run>/model.zip``."""
+    model_path = Path(model_path)
+    return model_path.parent.parent if model_path.parent.name == "checkpoints" else model_path.parent
 
 
 def versions() -> dict:
@@ -147,8 +159,7 @@ def earlier_stages(model_path: Path) -> int:
     A run records ``init_from.timesteps`` in its config.yml, which already includes the stages
     before it, so a chain of warm starts (stage 1 -> 2 -> 3 ...) adds up to the whole budget.
     """
-    run_dir = model_path.parent.parent if model_path.parent.name == "checkpoints" else model_path.parent
-    config_file = run_dir / "config.yml"
+    config_file = run_folder_of(model_path) / "config.yml"
     if not config_file.is_file():
         return 0
     return int(((yaml.safe_load(config_file.read_text()) or {}).get("init_from") or {}).get("timesteps") or 0)
