@@ -191,8 +191,39 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
         A JSON-friendly dict: the configuration, ``summary`` (see :func:`summarize`) and
         ``bounds`` (:func:`idleness_lower_bounds`).
     """
+    spec, cfg = evaluation_setup(map_name, n_agents, episodes, tests, steps, faults, **env)
+    policy = load_policy(strategy, spec, n_agents, cfg, seed=seed)
+    policy_cfg = getattr(policy, "cfg", None)
+    if policy_cfg is not None and policy_cfg.max_agents != cfg.max_agents:
+        cfg = make_config(None, **{**cfg.to_dict(), "max_agents": policy_cfg.max_agents})
+    per_episode = run_episodes(policy, spec, cfg, n_agents, tests * episodes, seed=seed,
+                               progress=progress, desc=f"{strategy} map {spec.name} n={n_agents}",
+                               deterministic=deterministic)
+    return {**request_of(strategy, spec, n_agents, episodes, tests, steps, seed, cfg, deterministic),
+            "summary": summarize(per_episode, tests),
+            "bounds": idleness_lower_bounds(spec.n_vertices, n_agents, steps)}
+
+
+def request_of(strategy: str, spec, n_agents: int, episodes: int, tests: int, steps: int, seed: int,
+               cfg, deterministic: bool = True) -> dict:
+    """The fields of an :func:`evaluate` result that say what was run (everything but the
+    figures): what ``patrolsb3.result_store`` compares to reuse a stored result."""
+    return {"strategy": canonical_name(strategy), "map": spec.name, "n_agents": int(n_agents),
+            "episodes": int(episodes), "tests": int(tests), "steps": int(steps), "seed": int(seed),
+            "faults": [list(f) for f in cfg.faults], "deterministic": bool(deterministic),
+            "env": cfg.to_dict()}
+
+
+def evaluation_setup(map_name, n_agents: int, episodes: int, tests: int, steps: int, faults=(), **env):
+    """Check an evaluation's arguments and build its map and env config (see :func:`evaluate`).
+
+    Returns:
+        ``(spec, cfg)``: the loaded map and the :class:`EnvConfig` the episodes run with.
+
+    Raises:
+        ValueError: a fault outside the episode, a count below 1, or a team that does not fit.
+    """
     spec = load_map(map_name)
-    name = canonical_name(strategy)
     late = [f for f in faults if f[0] >= steps]
     if late:
         raise ValueError(f"--faults {late[0][0]}:{late[0][1]} is outside the episode: STEP must be "
@@ -204,15 +235,4 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
         raise ValueError(f"team of {n_agents} agents does not fit: 1 <= agents <= max_agents={max_agents}")
     cfg = make_config(spec.name, max_agents=max_agents,
                       episode_steps=steps, faults=tuple(faults), invalid_action="raise", **env)
-    policy = load_policy(strategy, spec, n_agents, cfg, seed=seed)
-    policy_cfg = getattr(policy, "cfg", None)
-    if policy_cfg is not None and policy_cfg.max_agents != cfg.max_agents:
-        cfg = make_config(None, **{**cfg.to_dict(), "max_agents": policy_cfg.max_agents})
-    per_episode = run_episodes(policy, spec, cfg, n_agents, tests * episodes, seed=seed,
-                               progress=progress, desc=f"{strategy} map {spec.name} n={n_agents}",
-                               deterministic=deterministic)
-    return {"strategy": name, "map": spec.name, "n_agents": int(n_agents),
-            "episodes": int(episodes), "tests": int(tests), "steps": int(steps), "seed": int(seed),
-            "faults": [list(f) for f in faults], "deterministic": bool(deterministic), "env": cfg.to_dict(),
-            "summary": summarize(per_episode, tests),
-            "bounds": idleness_lower_bounds(spec.n_vertices, n_agents, steps)}
+    return spec, cfg

@@ -1,6 +1,8 @@
 """``patrolsb3 compare``: every strategy x maps x team sizes -> the paper's tables, a markdown
 report and plots (see ``patrolsb3.report``). Zoo columns (INTENTION, NOMSG, MSG) are filled
-when ``patrolsb3.zoo`` has a model for the map, empty otherwise."""
+when ``patrolsb3.zoo`` has a model for the map, empty otherwise. Heuristic results are kept in
+``OUT/results.json`` as they finish (``patrolsb3.result_store``): the same command again
+resumes an interrupted comparison or redraws a finished one without running it again."""
 
 
 def parse_agents(text: str) -> list[int]:
@@ -36,6 +38,9 @@ def add_arguments(parser):
     parser.add_argument("--no-progress", action="store_true")
     parser.add_argument("--stochastic", action="store_true",
                         help="zoo models sample their actions (default: the most likely legal action)")
+    parser.add_argument("--rerun", action="store_true",
+                        help="evaluate the heuristics again even when OUT/results.json already holds "
+                             "a result of this exact protocol (a rerun or an interrupted run reuses them)")
     parser.add_argument("--rerun-zoo", action="store_true",
                         help="evaluate zoo models again even when their eval.json already holds this "
                              "exact protocol (episodes, steps, seed, tests, action mode)")
@@ -44,8 +49,9 @@ def add_arguments(parser):
 def run(args):
     import importlib
 
-    from ..evaluate import evaluate
+    from ..evaluate import evaluate, evaluation_setup, request_of
     from ..report import EXTRA_COLUMNS, ZOO_COLUMNS, clean_figures, write_compare
+    from ..result_store import ResultStore
     if args.protocol == "paper":
         args.tests, args.episodes, args.steps = 10, 100, 14400
     maps = [m.strip() for m in args.maps.split(",") if m.strip()]
@@ -69,6 +75,7 @@ def run(args):
             missing = [m for m in maps if zoo is None or not zoo.available(m, name.split(":", 1)[1])]
             if missing:
                 raise ValueError(f"{name}: no zoo model for map(s) {', '.join(missing)}")
+    store = ResultStore(args.out)
     results = []
     for m in maps:
         if args.strategies:
@@ -84,10 +91,17 @@ def run(args):
                     r = zoo.cached_result(m, name.split(":", 1)[1], n, args.episodes, args.steps,
                                           args.seed, args.tests, deterministic=not args.stochastic)
                 source = "  (from the zoo's eval.json; --rerun-zoo to run it)" if r else ""
+                if r is None and not args.rerun and not name.startswith("zoo:"):
+                    spec, cfg = evaluation_setup(m, n, args.episodes, args.tests, args.steps)
+                    r = store.find(request_of(name, spec, n, args.episodes, args.tests, args.steps,
+                                              args.seed, cfg, deterministic=not args.stochastic))
+                    source = f"  (from {store.path}; --rerun to run it)" if r else ""
                 if r is None:
                     r = evaluate(name, m, n, episodes=args.episodes, tests=args.tests, steps=args.steps,
                                  seed=args.seed, progress=not args.no_progress,
                                  deterministic=not args.stochastic)
+                    if not name.startswith("zoo:"):
+                        store.add(r)
                 s = r["summary"]
                 print(f"map {r['map']} {name:>16} n={n}: {clean_figures(s)} "
                       f"BF {s['battery_failure_rate']['mean']:.3f} BLv {s['swap_battery_pct']['mean']:.1f}{source}",

@@ -1,0 +1,67 @@
+"""Evaluations kept on disk so that a comparison can be resumed or rerun without repeating them.
+
+``patrolsb3 compare`` writes every heuristic result it computes to ``<out>/results.json`` as
+soon as it has it; run again with the same ``--out``, it takes each (map, strategy, team size)
+whose stored result was run with exactly the same protocol (episodes, tests, steps, seed,
+action mode), env settings and env version, and evaluates only the rest. Zoo models are not
+taken from here (their weights can change under the same name): they come from their entry's
+``eval.json`` (``patrolsb3.zoo.cached_result``) or are evaluated again.
+"""
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+from .core.config import ENV_VERSION
+
+PROTOCOL_KEYS = ("strategy", "map", "n_agents", "episodes", "tests", "steps", "seed", "faults", "env")
+"""Result fields that must match for a stored result to stand for a new run."""
+
+
+def protocol(result: dict) -> tuple:
+    """The fields of a result (or of a request shaped like one) that decide whether it can be
+    reused: those of :data:`PROTOCOL_KEYS`, the action mode for zoo models (heuristics ignore
+    it) and the env version."""
+    learned = str(result["strategy"]).startswith("zoo:")
+    return (json.dumps([result.get(k) for k in PROTOCOL_KEYS], sort_keys=True),
+            bool(result.get("deterministic", True)) if learned else None,
+            result.get("env_version", ENV_VERSION))
+
+
+class ResultStore:
+    """The results of one comparison folder, ``<folder>/results.json`` (a JSON list of
+    ``evaluate()`` results, each with its ``env_version``).
+
+    Args:
+        folder: the comparison's output folder (created on the first :meth:`add`).
+    """
+
+    def __init__(self, folder):
+        self.path = Path(folder) / "results.json"
+        self.results: list[dict] = []
+        if self.path.is_file():
+            try:
+                self.results = json.loads(self.path.read_text())
+                if not isinstance(self.results, list):
+                    raise ValueError("not a list of results")
+            except ValueError as err:
+                raise ValueError(f"{self.path} is not a results file written by 'patrolsb3 compare' "
+                                 f"({err}); move it away or choose another --out") from None
+
+    def find(self, request: dict):
+        """The stored result with the same protocol as ``request`` (an ``evaluate()`` result
+        or a dict with the same keys), or None."""
+        key = protocol(request)
+        return next((r for r in reversed(self.results) if protocol(r) == key), None)
+
+    def add(self, result: dict) -> None:
+        """Store a result (replacing one with the same protocol) and write the file at once, so
+        an interrupted comparison keeps what it finished."""
+        result = {**result, "env_version": result.get("env_version", ENV_VERSION)}
+        key = protocol(result)
+        self.results = [r for r in self.results if protocol(r) != key] + [result]
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = self.path.with_suffix(".json.tmp")
+        tmp.write_text(json.dumps(self.results))
+        os.replace(tmp, self.path)

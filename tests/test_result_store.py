@@ -1,0 +1,49 @@
+"""patrolsb3.result_store and the resumable 'patrolsb3 compare' built on it."""
+import json
+
+import pytest
+
+from patrolsb3 import cli
+from patrolsb3.evaluate import evaluate
+from patrolsb3.result_store import ResultStore
+
+
+def test_a_stored_result_stands_only_for_the_same_protocol(tmp_path):
+    store = ResultStore(tmp_path)
+    result = evaluate("CR", "A", 2, episodes=1, steps=30, seed=1, progress=False)
+    assert store.find(result) is None
+    store.add(result)
+    again = ResultStore(tmp_path)                                 # read back from results.json
+    assert again.find(result)["summary"] == json.loads(json.dumps(result["summary"]))
+    for change in ({"seed": 2}, {"steps": 31}, {"n_agents": 3}, {"strategy": "SEBS"}, {"episodes": 2},
+                   {"env": {**result["env"], "p_dyn_max": 0.0}}, {"env_version": "patrol-v0-old"}):
+        assert again.find({**result, **change}) is None, change
+    # heuristics ignore the action mode; a zoo model's result is kept apart per mode
+    assert again.find({**result, "deterministic": False}) is not None
+    learned = {**result, "strategy": "zoo:rl-msg"}
+    again.add(learned)
+    assert again.find({**learned, "deterministic": False}) is None
+    store.add(result)                                             # the same protocol replaces, not duplicates
+    assert len(json.loads((tmp_path / "results.json").read_text())) == 1
+
+
+def test_a_broken_results_file_is_named(tmp_path):
+    (tmp_path / "results.json").write_text("{not json")
+    with pytest.raises(ValueError, match="results.json is not a results file"):
+        ResultStore(tmp_path)
+
+
+def test_compare_again_reuses_the_heuristics_it_ran(tmp_path, capsys):
+    args = ["compare", "--maps", "A", "--agents", "1", "--episodes", "1", "--steps", "40",
+            "--strategies", "CR", "--out", str(tmp_path), "--no-progress"]
+    assert cli.main(args) == 0
+    first = capsys.readouterr().out
+    table = (tmp_path / "A-MAX.csv").read_text()
+    assert "results.json" not in first
+    assert cli.main(args + ["--strategies", "CR,SEBS"]) == 0
+    second = capsys.readouterr().out
+    assert "CR n=1" in second and "from " in second.split("CR n=1")[1].splitlines()[0]
+    assert "from " not in second.split("SEBS n=1")[1].splitlines()[0]       # new: run
+    assert (tmp_path / "A-MAX.csv").read_text().splitlines()[1].split(",")[1] == table.splitlines()[1].split(",")[1]
+    assert cli.main(args + ["--rerun"]) == 0
+    assert "results.json" not in capsys.readouterr().out
