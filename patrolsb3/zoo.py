@@ -259,7 +259,9 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None) -
             checkpoint is taken (and named in config.yml as ``source_model``).
         checkpoint: a specific checkpoint file of the run to export instead.
         zoo_dir: the zoo root (default: the repository's ``zoo/``).
-        budget: extra facts about the training budget (e.g. cpu_hours), stored in config.yml.
+        budget: extra facts about the training budget, stored in config.yml. Without
+            ``cpu_hours`` in it, the CPU hours the run measured (``cpu_time.csv``, its
+            warm-start stages included) are recorded, when every stage measured them.
 
     Returns:
         The entry folder ``zoo/<map>/<variant>/``.
@@ -272,6 +274,7 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None) -
     run_dir = Path(run_dir)
     if not (run_dir / "config.yml").is_file():
         raise ZooError(f"{run_dir}: no config.yml; not a run folder of 'patrolsb3 train'")
+    from .sb3.cpu_time import cpu_hours_of
     from .sb3.train import newest_checkpoint
     source = Path(checkpoint) if checkpoint else (run_dir / "model.zip" if (run_dir / "model.zip").is_file()
                                                    else newest_checkpoint(run_dir))
@@ -284,13 +287,18 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None) -
     folder = entry_dir(config["map"], config["variant"], zoo_dir)
     folder.mkdir(parents=True, exist_ok=True)
     model.policy.save(str(folder / "model.zip"))
-    for name in ("command.txt", "curve.csv", "eval.csv"):
+    for name in ("command.txt", "curve.csv", "eval.csv", "cpu_time.csv"):
         if (run_dir / name).is_file():
             shutil.copyfile(run_dir / name, folder / name)
     config["env_version"] = config.get("versions", {}).get("env_version", ENV_VERSION)
     config["date"] = datetime.date.fromtimestamp(source.stat().st_mtime).isoformat()
     config["source_model"] = str(source)
     config["budget"] = {"timesteps": int(model.num_timesteps), **(budget or {})}
+    if "cpu_hours" in config["budget"]:
+        config["budget"]["cpu_hours_source"] = "given (--cpu-hours)"
+    elif (measured := cpu_hours_of(source)) is not None:
+        config["budget"]["cpu_hours"] = round(measured, 3)
+        config["budget"]["cpu_hours_source"] = "measured (cpu_time.csv of the run and its warm-start sources)"
     warm = (config.get("init_from") or {}).get("timesteps")
     if warm:  # a warm-started run: its budget includes the run it started from
         config["budget"]["timesteps_this_run"] = int(model.num_timesteps)

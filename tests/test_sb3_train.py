@@ -11,6 +11,7 @@ from patrolsb3.core import parse_map
 from patrolsb3.sb3 import make_vec_env
 from patrolsb3.sb3.evaluation import RandomMaskedPolicy, evaluate
 from patrolsb3.sb3.hyperparams import parse_set, per_phase, schedule
+from patrolsb3.sb3.cpu_time import cpu_hours_of
 from patrolsb3.sb3.maskable_recurrent_ppo import MaskableRecurrentPPO
 from patrolsb3.sb3.train import curriculum_teams, newest_checkpoint, train
 
@@ -153,7 +154,8 @@ def test_init_from_starts_a_new_run_from_the_weights(tmp_path):
     for name, value in model.policy.state_dict().items():
         assert th.equal(value, src_weights[name]), name
     config = yaml.safe_load((run / "config.yml").read_text())
-    assert config["init_from"] == {"path": str(source / "model.zip"), "timesteps": 400}
+    assert config["init_from"] == {"path": str(source / "model.zip"), "timesteps": 400,
+                                   "cpu_hours": cpu_hours_of(source / "model.zip")}
     # a third stage started from the second counts both earlier runs
     third = train(map=ROOM, timesteps=400, out=tmp_path, run_id="third", init_from=run, progress_bar=False,
                   hyperparams=tiny_hp(curriculum=False))
@@ -167,8 +169,9 @@ def test_init_from_starts_a_new_run_from_the_weights(tmp_path):
     (source / "model.zip").unlink()
     stopped = train(map=ROOM, timesteps=400, out=tmp_path, run_id="from-stopped", init_from=source,
                     progress_bar=False, hyperparams=tiny_hp())
+    checkpoint = source / "checkpoints" / "model_400_steps.zip"
     assert yaml.safe_load((stopped / "config.yml").read_text())["init_from"] == {
-        "path": str(source / "checkpoints" / "model_400_steps.zip"), "timesteps": 400}
+        "path": str(checkpoint), "timesteps": 400, "cpu_hours": cpu_hours_of(checkpoint)}
 
 
 def test_init_from_errors(tmp_path):

@@ -19,7 +19,8 @@ def add_arguments(parser):
     p_export.add_argument("--zoo-dir", default=None)
     p_export.add_argument("--checkpoint", default=None,
                           help="checkpoint file to export (default: model.zip, else the newest checkpoint)")
-    p_export.add_argument("--cpu-hours", type=float, default=None, help="training CPU time to record")
+    p_export.add_argument("--cpu-hours", type=float, default=None,
+                          help="training CPU hours to record (default: what the run measured in its cpu_time.csv, warm-start stages included)")
     p_export.add_argument("--episodes", type=int, default=10, help="evaluation episodes per team size")
     p_export.add_argument("--steps", type=int, default=14400, help="steps per evaluation episode")
     p_export.add_argument("--seed", type=int, default=0)

@@ -7,6 +7,7 @@ Run folder ``<out>/<map>/<variant>/<run_id>/``::
     config.yml         env config, map name and shape, algorithm hyperparameters, versions
     command.txt        the command line(s) that made / resumed the run
     curve.csv          one row per finished parallel episode (learning curve)
+    cpu_time.csv       CPU seconds spent by agent-steps reached (``patrolsb3.sb3.cpu_time``)
     eval.csv           periodic evaluation on the paper metrics at 1..max_agents agents
     tb/                TensorBoard logs (SB3 logger)
 
@@ -25,6 +26,7 @@ import yaml
 from stable_baselines3.common.vec_env import VecNormalize
 
 from .algorithms import DEFAULT_ALGORITHM, get_algorithm
+from .cpu_time import cpu_hours_of
 from .curriculum import CURRICULUM, curriculum_stage
 from .hyperparams import load_hyperparams, merge, per_phase, schedule
 
@@ -192,7 +194,8 @@ def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]
     try:  # a whole model (checkpoint or run's model.zip)
         model = algo_class.load(str(path), device="cpu")
         return model.policy.state_dict(), {"path": str(path),
-                                           "timesteps": int(model.num_timesteps) + earlier_stages(path)}
+                                           "timesteps": int(model.num_timesteps) + earlier_stages(path),
+                                           "cpu_hours": cpu_hours_of(path)}
     except Exception as exc:  # noqa: BLE001 - try the policy-only layout next
         errors.append(f"as a {algo_class.__name__}: {type(exc).__name__}: {exc}")
     try:  # a policy only (the zoo's model.zip)
@@ -200,11 +203,12 @@ def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]
     except Exception as exc:  # noqa: BLE001
         errors.append(f"as a {policy_class.__name__}: {type(exc).__name__}: {exc}")
         raise ValueError(f"--init-from: {path} cannot be loaded ({'; '.join(errors)})") from exc
-    timesteps = None
+    budget = {}
     config_file = path.parent / "config.yml"
     if config_file.is_file():
-        timesteps = (yaml.safe_load(config_file.read_text()) or {}).get("budget", {}).get("timesteps")
-    return policy.state_dict(), {"path": str(path), "timesteps": timesteps}
+        budget = (yaml.safe_load(config_file.read_text()) or {}).get("budget", {})
+    return policy.state_dict(), {"path": str(path), "timesteps": budget.get("timesteps"),
+                                 "cpu_hours": budget.get("cpu_hours")}
 
 
 def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="runs/", algo: str | None = None,
@@ -250,6 +254,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
 
     from ..core.maps import load_map
     from .callbacks import LearningCurveCallback, PaperMetricsEvalCallback
+    from .cpu_time import CpuTimeCallback, restart_at  # noqa: PLC0415 - next to the other callbacks
     from .curriculum import CurriculumCallback
     from .variants import variant_overrides
     from .vec_env import DEFAULT_AGENTS, make_vec_env
@@ -324,7 +329,8 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
         return make_vec_env(spec_map, agents=eval_teams, variant=variant, seed=seed + 10_000,
                             strict=spec.masked, **eval_env_kwargs)
 
-    callbacks = [CheckpointCallback(save_freq=max(1, int(hp.get("checkpoint_freq", 200_000)) // rows),
+    cpu_time = CpuTimeCallback(run_dir, restart_at(run_dir, model.num_timesteps) if checkpoint is not None else 0.0)
+    callbacks = [cpu_time, CheckpointCallback(save_freq=max(1, int(hp.get("checkpoint_freq", 200_000)) // rows),
                                     save_path=str(run_dir / "checkpoints"), name_prefix="model",
                                     save_vecnormalize=True),
                  LearningCurveCallback(run_dir / "curve.csv", max_agents),
@@ -338,6 +344,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
                         progress_bar=progress_bar, tb_log_name=spec.name)
     finally:
         model.save(run_dir / "checkpoints" / f"model_{model.num_timesteps}_steps.zip")
+        cpu_time.record(model.num_timesteps)
         if isinstance(vec_env, VecNormalize):
             vec_env.save(str(run_dir / "checkpoints" / VECNORMALIZE_FILE.format(model.num_timesteps)))
         vec_env.close()

@@ -1,0 +1,114 @@
+"""The CPU time a training run spent, measured by the run itself: ``<run>/cpu_time.csv``.
+
+One row when each rollout starts (the update of the rollout before it done) and one when the
+run stops, with its last checkpoint: the agent-steps reached and the CPU seconds of the training process (every thread, ``time.process_time``) spent
+in ``learn()`` so far, counted across ``--resume`` calls. A resumed run first cuts the rows past
+the checkpoint it resumes from, so the file always describes the path that led to its
+checkpoints. A warm-started run (``--init-from``) records the CPU hours of its source in
+``config.yml`` (``init_from.cpu_hours``), so :func:`cpu_hours_of` adds up a chain of stages,
+which is what ``patrolsb3 zoo export`` records as the entry's budget.
+"""
+from __future__ import annotations
+
+import csv
+import time
+from pathlib import Path
+
+import yaml
+from stable_baselines3.common.callbacks import BaseCallback
+
+CPU_TIME_FILE = "cpu_time.csv"
+FIELDS = ("timesteps", "cpu_seconds")
+
+
+def read_rows(run_dir) -> list[tuple[int, float]]:
+    """The rows of ``run_dir/cpu_time.csv`` as (timesteps, cpu_seconds), [] when there is none."""
+    path = Path(run_dir) / CPU_TIME_FILE
+    if not path.is_file():
+        return []
+    with path.open(newline="") as f:
+        return [(int(r["timesteps"]), float(r["cpu_seconds"])) for r in csv.DictReader(f)]
+
+
+def cpu_seconds_at(run_dir, timesteps: int) -> float | None:
+    """CPU seconds the run had spent when it reached ``timesteps`` (the last row at or before
+    it), or None when the run has no record that far."""
+    rows = [s for t, s in read_rows(run_dir) if t <= timesteps]
+    return rows[-1] if rows else None
+
+
+def restart_at(run_dir, timesteps: int) -> float:
+    """Cut ``cpu_time.csv`` back to ``timesteps`` (a resume from that checkpoint) and return the
+    CPU seconds spent up to there (0 for a run without a record)."""
+    rows = [(t, s) for t, s in read_rows(run_dir) if t <= timesteps]
+    path = Path(run_dir) / CPU_TIME_FILE
+    if path.is_file():
+        with path.open("w", newline="") as f:
+            writer = csv.writer(f)
+            writer.writerow(FIELDS)
+            writer.writerows(rows)
+    return rows[-1][1] if rows else 0.0
+
+
+def model_steps(model_path) -> int | None:
+    """Agent-steps of a checkpoint from its name (``model_<steps>_steps.zip``); for a run's
+    ``model.zip`` the last row of its cpu_time.csv; None when neither tells."""
+    from .train import CHECKPOINT_RE
+    model_path = Path(model_path)
+    if m := CHECKPOINT_RE.search(model_path.name):
+        return int(m.group(1))
+    rows = read_rows(model_path.parent)
+    return rows[-1][0] if rows else None
+
+
+def cpu_hours_of(model_path) -> float | None:
+    """CPU hours spent to train a checkpoint (or a run's model.zip), every warm-start stage
+    before it included; None when a part of that chain was not measured (a run older than
+    this record, or a source without a figure)."""
+    from .train import run_folder_of
+    run_dir = run_folder_of(model_path)
+    steps = model_steps(model_path)
+    own = cpu_seconds_at(run_dir, steps) if steps is not None else None
+    if own is None:
+        return None
+    config_file = run_dir / "config.yml"
+    config = (yaml.safe_load(config_file.read_text()) or {}) if config_file.is_file() else {}
+    earlier = 0.0
+    if config.get("init_from"):
+        earlier = config["init_from"].get("cpu_hours")
+        if earlier is None:
+            return None
+    return float(earlier) + own / 3600.0
+
+
+class CpuTimeCallback(BaseCallback):
+    """Appends (timesteps, CPU seconds) to ``cpu_time.csv`` as every rollout starts.
+
+    Args:
+        run_dir: the run folder.
+        offset_seconds: CPU seconds spent before this call (a resumed run: :func:`restart_at`).
+    """
+
+    def __init__(self, run_dir, offset_seconds: float = 0.0, verbose: int = 0):
+        super().__init__(verbose)
+        self.path = Path(run_dir) / CPU_TIME_FILE
+        self.offset = float(offset_seconds)
+        self.started = time.process_time()
+
+    def _on_training_start(self) -> None:
+        self.started = time.process_time()
+
+    def _on_step(self) -> bool:
+        return True
+
+    def _on_rollout_start(self) -> None:
+        self.record(self.num_timesteps)
+
+    def record(self, timesteps: int) -> None:
+        """Append one row: ``timesteps`` and the CPU seconds spent so far."""
+        new = not self.path.exists()
+        with self.path.open("a", newline="") as f:
+            writer = csv.writer(f)
+            if new:
+                writer.writerow(FIELDS)
+            writer.writerow([int(timesteps), round(self.offset + time.process_time() - self.started, 3)])
