@@ -90,6 +90,24 @@ class PatrolParallelEnv(ParallelEnv):
         self._act_space = spaces.MultiDiscrete([self.cfg.n_symbols, 5])
         self._viewer = None
 
+    def reconfigure(self, **overrides) -> None:
+        """Change EnvConfig fields that leave the spaces as they are (``episode_steps``,
+        ``init_battery``, rewards, wind ...), effective from the next reset; a training run
+        uses it to give some parallel episodes other settings (the ``mix`` hyperparameter).
+
+        Raises:
+            ValueError: a field that would change the observation or action spaces or the
+                phases (``max_agents``, ``comm``, ``message_timing``, ``local_idleness``, ...).
+            TypeError: an unknown EnvConfig field.
+        """
+        cfg = make_config(None, **{**self.cfg.to_dict(), **overrides})
+        shape = (lambda c: (c.max_agents, c.n_symbols, c.two_phase, vector_size(c), c.comm))
+        if shape(cfg) != shape(self.cfg):
+            changed = [k for k in overrides if getattr(cfg, k) != getattr(self.cfg, k)]
+            raise ValueError(f"reconfigure: {', '.join(changed)} would change the spaces or phases "
+                             f"of the env; only settings that keep them can differ per episode")
+        self.cfg = cfg
+
     def _check_team(self, n_agents):
         if not 1 <= int(n_agents) <= self.cfg.max_agents:
             raise ValueError(f"n_agents={n_agents} must be between 1 and max_agents={self.cfg.max_agents}")

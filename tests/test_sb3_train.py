@@ -213,3 +213,18 @@ def test_interrupted_run_saves_a_checkpoint_and_the_cli_says_how_to_resume(tmp_p
     monkeypatch.setattr(train_command, "run", interrupted)
     assert cli.main(["train", "--map", "A"]) == 130
     assert "interrupted (a checkpoint was saved; continue with --resume)" in capsys.readouterr().err
+
+
+def test_mix_runs_some_parallel_episodes_with_other_env_settings(tmp_path):
+    hp = tiny_hp(n_envs=4, curriculum=False, mix={"episodes": 2, "env": {"episode_steps": 3}})
+    run = train(map=ROOM, variant="rl-no-msg", timesteps=400, out=tmp_path, hyperparams=hp, progress_bar=False)
+    lengths = {int(r["sim_steps"]) for r in read_curve(run / "curve.csv")}
+    assert lengths == {3, 5}                                # the mixed episodes and the others
+    assert yaml.safe_load((run / "config.yml").read_text())["hyperparams"]["mix"]["episodes"] == 2
+    for bad, match in (({"episodes": 5, "env": {"episode_steps": 3}}, "4 parallel episodes"),
+                       ({"env": {"episode_steps": 3}}, "mix must be"),
+                       ({"episodes": 1, "env": {"comm": "none"}}, "comm")):
+        with pytest.raises((ValueError, TypeError), match=match):
+            train(map=ROOM, variant="rl-msg", timesteps=400, out=tmp_path, run_id="bad",
+                  hyperparams=tiny_hp(n_envs=4, mix=bad), progress_bar=False)
+        assert not (tmp_path / "room" / "rl-msg" / "bad").exists()    # fix it and run the same command

@@ -183,6 +183,35 @@ def test_horizon_marks_truncation_and_keeps_terminal_observation(spec, variant, 
     assert venv.action_masks()[0, 16 + STAY]  # masks of the new episode are in place
 
 
+def test_episode_env_gives_one_parallel_episode_its_own_settings(spec):
+    venv = make_vec_env(spec, agents=[2, 2], variant="rl-no-msg", seed=1, episode_steps=6,
+                        episode_env={1: {"episode_steps": 3, "init_battery": [0.1, 0.1]}})
+    assert venv.get_env(0).cfg.episode_steps == 6 and venv.get_env(1).cfg.episode_steps == 3
+    venv.reset()
+    b_max = venv.get_env(0).cfg.b_max
+    batteries = [venv.get_env(e).core_state.battery[0, :2] / b_max for e in (0, 1)]   # (2,) each
+    assert (batteries[0] >= 0.9).all() and np.allclose(batteries[1], 0.1)
+    rng = np.random.default_rng(0)
+    ends = {}
+    for t in range(1, 7):
+        _, _, dones, infos = venv.step(masked_actions(venv.action_masks(), rng))
+        for e in (0, 1):
+            if dones[e * A] and e not in ends:
+                ends[e] = (t, infos[e * A]["team_episode"]["sim_steps"])
+    assert ends == {1: (3, 3), 0: (6, 6)}
+
+
+def test_episode_env_refuses_what_would_change_the_spaces(spec):
+    with pytest.raises(ValueError, match="local_idleness would change the spaces"):
+        make_vec_env(spec, agents=[1, 1], variant="rl-no-msg", episode_env={1: {"local_idleness": True}})
+    with pytest.raises(ValueError, match="max_agents"):
+        make_vec_env(spec, agents=[1, 1], variant="rl-no-msg", episode_env={0: {"max_agents": 4}})
+    with pytest.raises(ValueError, match="no parallel episode 2"):
+        make_vec_env(spec, agents=[1, 1], variant="rl-no-msg", episode_env={2: {"episode_steps": 3}})
+    with pytest.raises(TypeError):
+        make_vec_env(spec, agents=[1, 1], variant="rl-no-msg", episode_env={0: {"nope": 3}})
+
+
 def test_termination_is_not_truncation(spec):
     venv = make_vec_env(spec, agents=[1], variant="rl-no-msg", seed=0, faults=((0, 1),))
     venv.reset()

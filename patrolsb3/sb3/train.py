@@ -33,7 +33,7 @@ from .hyperparams import load_hyperparams, merge, per_phase, schedule
 ALGO_KEYS = ("learning_rate", "n_steps", "n_epochs", "gamma", "gae_lambda", "clip_range", "ent_coef",
              "vf_coef", "max_grad_norm", "n_minibatches", "batch_size", "policy_kwargs", "target_kl")
 RUN_KEYS = ("algo", "timesteps", "n_envs", "curriculum", "env", "checkpoint_freq", "eval_freq",
-            "eval_episode_steps", "eval_episodes", "torch_threads", "normalize_reward")
+            "eval_episode_steps", "eval_episodes", "torch_threads", "normalize_reward", "mix")
 CHECKPOINT_RE = re.compile(r"model_(\d+)_steps\.zip$")
 VECNORMALIZE_FILE = "model_vecnormalize_{}_steps.pkl"
 """Reward-normalisation statistics saved beside each checkpoint (SB3's CheckpointCallback name)."""
@@ -153,6 +153,26 @@ def _check_resumable(run_dir: Path, config: dict) -> Path:
         if saved.get("env") != config["env"]:
             raise ValueError(f"--resume: the env config of {run_dir} differs from this run's")
     return checkpoint
+
+
+def mixed_episodes(hp: dict, n_episodes: int) -> dict:
+    """The ``mix`` hyperparameter as ``make_vec_env``'s ``episode_env``: the first
+    ``mix.episodes`` parallel episodes run with ``env`` + ``mix.env`` (e.g. a recharge drill of
+    short low-battery episodes beside the long ones), the others with ``env``.
+
+    Raises:
+        ValueError: a mix without ``episodes`` and ``env``, or more episodes than the run has.
+    """
+    mix = hp.get("mix")
+    if not mix:
+        return {}
+    if not isinstance(mix, dict) or set(mix) != {"episodes", "env"} or not isinstance(mix["env"], dict):
+        raise ValueError(f"mix must be {{episodes: K, env: {{EnvConfig overrides}}}} "
+                         f"(e.g. --set mix.episodes=4 mix.env.episode_steps=400), got {mix!r}")
+    k = int(mix["episodes"])
+    if not 0 < k <= n_episodes:
+        raise ValueError(f"mix.episodes={k}: the run has {n_episodes} parallel episodes")
+    return {i: dict(mix["env"]) for i in range(k)}
 
 
 def earlier_stages(model_path: Path) -> int:
@@ -292,15 +312,15 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
         checkpoint = _check_resumable(run_dir, config)
     elif run_dir.exists() and any(run_dir.iterdir()):
         raise ValueError(f"run folder {run_dir} exists; pass --resume to continue it or --run-id to start another")
+    start_teams = teams[0] if hp.get("curriculum", True) else final_teams
+    vec_env = make_vec_env(spec_map, agents=start_teams, variant=variant, seed=seed, strict=spec.masked,
+                           episode_env=mixed_episodes(hp, len(start_teams)), **env_kwargs)  # bad env: no run folder
     (run_dir / "checkpoints").mkdir(parents=True, exist_ok=True)
     if not resume:
         (run_dir / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
     with (run_dir / "command.txt").open("a") as f:
         f.write((command or " ".join(sys.argv)) + "\n")
 
-    start_teams = teams[0] if hp.get("curriculum", True) else final_teams
-    vec_env = make_vec_env(spec_map, agents=start_teams, variant=variant, seed=seed, strict=spec.masked,
-                           **env_kwargs)
     rows = vec_env.num_envs
     if hp.get("normalize_reward", False):
         vec_env = normalized_rewards(vec_env, checkpoint, per_phase(hp["gamma"], vec_env.phases_per_step))

@@ -318,7 +318,8 @@ class PatrolVecEnv(VecEnvWrapper):
 
 
 def make_vec_env(map="A", agents: Sequence[int] = DEFAULT_AGENTS, variant: str = "rl-msg",
-                 seed: int | None = 0, strict: bool = True, **env_kwargs) -> PatrolVecEnv:
+                 seed: int | None = 0, strict: bool = True, episode_env: dict | None = None,
+                 **env_kwargs) -> PatrolVecEnv:
     """Build the parameter-shared SB3 vector env of a training run.
 
     Args:
@@ -328,6 +329,10 @@ def make_vec_env(map="A", agents: Sequence[int] = DEFAULT_AGENTS, variant: str =
         seed: seed of the first reset (episode i gets seed + i); None for fresh entropy.
         strict: True: a masked action raises in the env; False: masked moves act as Stay
             (``invalid_action="stay"``), for algorithms without masks.
+        episode_env: {parallel episode index: EnvConfig overrides} for episodes that run with
+            other settings than ``env_kwargs`` (only settings that keep the spaces, see
+            :meth:`PatrolParallelEnv.reconfigure`), e.g. short low-battery episodes beside
+            long ones.
         **env_kwargs: other EnvConfig fields (``episode_steps``, ``message_timing``, ...).
 
     Returns:
@@ -352,6 +357,10 @@ def make_vec_env(map="A", agents: Sequence[int] = DEFAULT_AGENTS, variant: str =
     markov = ss.pettingzoo_env_to_vec_env_v1(EpisodeResets(template, agents[0]))
     venv = ss.concat_vec_envs_v1(markov, len(agents), num_cpus=0, base_class="stable_baselines3")
     vec_env = PatrolVecEnv(venv)
+    for i, overrides in (episode_env or {}).items():
+        if not 0 <= int(i) < len(agents):
+            raise ValueError(f"episode_env: no parallel episode {i} (there are {len(agents)})")
+        vec_env.get_env(int(i)).reconfigure(**overrides)
     vec_env.set_agents(agents)
     vec_env.seed(seed)
     return vec_env
