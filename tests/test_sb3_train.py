@@ -13,7 +13,7 @@ from patrolsb3.sb3.evaluation import RandomMaskedPolicy, evaluate
 from patrolsb3.sb3.hyperparams import parse_set, per_phase, schedule
 from patrolsb3.sb3.cpu_time import cpu_hours_of
 from patrolsb3.sb3.maskable_recurrent_ppo import MaskableRecurrentPPO
-from patrolsb3.sb3.train import curriculum_teams, newest_checkpoint, train
+from patrolsb3.sb3.train import curriculum_teams, mixed_episodes, newest_checkpoint, train
 
 th.set_num_threads(1)
 ROOM = parse_map("S.....\n......\n......\n......", name="room")
@@ -221,7 +221,10 @@ def test_mix_runs_some_parallel_episodes_with_other_env_settings(tmp_path):
     lengths = {int(r["sim_steps"]) for r in read_curve(run / "curve.csv")}
     assert lengths == {3, 5}                                # the mixed episodes and the others
     assert yaml.safe_load((run / "config.yml").read_text())["hyperparams"]["mix"]["episodes"] == 2
+    assert mixed_episodes({"mix": {"episodes": [0, 2], "env": {"episode_steps": 3}}}, 4) == {
+        0: {"episode_steps": 3}, 2: {"episode_steps": 3}}
     for bad, match in (({"episodes": 5, "env": {"episode_steps": 3}}, "4 parallel episodes"),
+                       ({"episodes": [1, 4], "env": {"episode_steps": 3}}, "4 parallel episodes"),
                        ({"env": {"episode_steps": 3}}, "mix must be"),
                        ({"episodes": 1, "env": {"comm": "none"}}, "comm")):
         with pytest.raises((ValueError, TypeError), match=match):

@@ -156,23 +156,27 @@ def _check_resumable(run_dir: Path, config: dict) -> Path:
 
 
 def mixed_episodes(hp: dict, n_episodes: int) -> dict:
-    """The ``mix`` hyperparameter as ``make_vec_env``'s ``episode_env``: the first
-    ``mix.episodes`` parallel episodes run with ``env`` + ``mix.env`` (e.g. a recharge drill of
-    short low-battery episodes beside the long ones), the others with ``env``.
+    """The ``mix`` hyperparameter as ``make_vec_env``'s ``episode_env``: the parallel episodes
+    named by ``mix.episodes`` (a count K: the first K; or a list of indices) run with ``env`` +
+    ``mix.env`` (e.g. a recharge drill of short low-battery episodes beside the long ones), the
+    others with ``env``. Team sizes are per index too (``1,1,1,1,2,3,4,5`` at the end of the
+    curriculum), so a list like ``[0,2,4,6]`` mixes teams of every size.
 
     Raises:
-        ValueError: a mix without ``episodes`` and ``env``, or more episodes than the run has.
+        ValueError: a mix without ``episodes`` and ``env``, or episodes the run does not have.
     """
     mix = hp.get("mix")
     if not mix:
         return {}
     if not isinstance(mix, dict) or set(mix) != {"episodes", "env"} or not isinstance(mix["env"], dict):
-        raise ValueError(f"mix must be {{episodes: K, env: {{EnvConfig overrides}}}} "
+        raise ValueError(f"mix must be {{episodes: K or [indices], env: {{EnvConfig overrides}}}} "
                          f"(e.g. --set mix.episodes=4 mix.env.episode_steps=400), got {mix!r}")
-    k = int(mix["episodes"])
-    if not 0 < k <= n_episodes:
-        raise ValueError(f"mix.episodes={k}: the run has {n_episodes} parallel episodes")
-    return {i: dict(mix["env"]) for i in range(k)}
+    chosen = mix["episodes"]
+    indices = list(range(int(chosen))) if isinstance(chosen, int) else [int(i) for i in chosen]
+    if not indices or not all(0 <= i < n_episodes for i in indices):
+        raise ValueError(f"mix.episodes={chosen!r}: the run has {n_episodes} parallel episodes "
+                         f"(give a count 1..{n_episodes} or indices 0..{n_episodes - 1})")
+    return {i: dict(mix["env"]) for i in indices}
 
 
 def earlier_stages(model_path: Path) -> int:
