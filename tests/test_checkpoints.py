@@ -6,7 +6,7 @@ import pytest
 import torch
 
 from patrolsb3 import cli, zoo
-from patrolsb3.checkpoints import rank, run_checkpoints, validate
+from patrolsb3.checkpoints import rank, run_checkpoints, saved_steps, validate
 from patrolsb3.core import load_map, make_config, reset_state
 from patrolsb3.sb3.train import train
 
@@ -26,12 +26,18 @@ def run(tmp_path_factory):
 
 
 def test_every_checkpoint_in_step_order_then_the_final_model(run, tmp_path):
+    import shutil
     paths = run_checkpoints(run)
-    steps = [int(p.name.split("_")[1]) for p in paths[:-1]]
-    assert paths[-1].name == "model.zip" and len(steps) >= 2 and steps == sorted(steps)
+    steps = [int(p.name.split("_")[1]) for p in paths]
+    assert len(steps) >= 2 and steps == sorted(steps) and steps[-1] == 800
     assert all(p.name == f"model_{s}_steps.zip" for p, s in zip(paths, steps))
+    assert saved_steps(run / "model.zip") == 800          # the same model as the last checkpoint: once
+    copy = tmp_path / "copy"
+    shutil.copytree(run, copy)
+    (copy / "checkpoints" / "model_800_steps.zip").unlink()
+    assert [p.name for p in run_checkpoints(copy)][-2:] == ["model_400_steps.zip", "model.zip"]
     with pytest.raises(FileNotFoundError, match="no checkpoints"):
-        run_checkpoints(tmp_path)
+        run_checkpoints(tmp_path / "nothing")
 
 
 def test_load_checkpoint_acts_like_the_zoo_export_of_it(run, tmp_path):
