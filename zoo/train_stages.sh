@@ -5,6 +5,7 @@
 #   zoo/train_stages.sh 1 SECONDS [--resume]   # stage 1: patrol only, STAGE1_OUT (runs/stage1)
 #   zoo/train_stages.sh 2 SECONDS [--resume]   # stage 2: patrol + recharge, STAGE2_OUT (runs/zoo)
 #   zoo/train_stages.sh 3 SECONDS [--resume]   # stage 3: recharge drill, STAGE3_OUT (runs/stage3)
+#   zoo/train_stages.sh 4 SECONDS [--resume]   # stage 4: drill + long episodes mixed, STAGE4_OUT (runs/stage4)
 #
 # Each stage after the first starts from the weights of the stage before it (its run folder:
 # model.zip, or the newest checkpoint of a run stopped by time).
@@ -15,11 +16,16 @@
 # whose batteries start at 5-40 %, so that most of what an agent lives through is the trip to
 # the station (stage 2 alone left agents patrolling until their battery ran out); choose its
 # checkpoint with `patrolsb3 zoo validate` (a later stage back on long episodes erased the
-# recharge again: zoo/README.md). STAGE1_RUNS / ZOO_RUNS pick the runs (map:variant); the
-# shared settings below apply to every variant alike.
+# recharge again: zoo/README.md). Stage 4 starts from the chosen drill checkpoint (exported to
+# the zoo: STAGE4_FROM, default zoo/{map}/{variant}) and mixes both in every batch: four of the
+# eight parallel episodes (teams 1, 1, 2, 4) are drill episodes, the other four (teams 1, 1, 3,
+# 5) last 1,500 steps from 15-100 %, so the patrol improves on long episodes while the
+# recharge keeps being practised; choose its checkpoint with `patrolsb3 zoo validate` too.
+# STAGE1_RUNS / ZOO_RUNS pick the runs (map:variant); the shared settings below apply to every
+# variant alike.
 set -euo pipefail
-STAGE=${1:?usage: zoo/train_stages.sh 1|2|3 SECONDS [--resume]}
-SECONDS_PER_CALL=${2:?usage: zoo/train_stages.sh 1|2|3 SECONDS [--resume]}
+STAGE=${1:?usage: zoo/train_stages.sh 1|2|3|4 SECONDS [--resume]}
+SECONDS_PER_CALL=${2:?usage: zoo/train_stages.sh 1|2|3|4 SECONDS [--resume]}
 RESUME=${3:-}
 # env.local_idleness and env.c_d (the difference reward's weight, paper 50 / 5 = 10) are this
 # zoo's changes to the observation and the reward scale; zoo/README.md says why
@@ -37,6 +43,10 @@ case "$STAGE" in
        INIT_FROM="${STAGE2_OUT:-runs/zoo}/{map}/{variant}/MaskableRecurrentPPO_seed0" \
        ZOO_RUNS=${ZOO_RUNS:-"A:rl-msg A:rl-no-msg A:rl-intention"} \
        ZOO_SET="env.episode_steps=400 env.init_battery=[0.05,0.4] $SHARED learning_rate=3e-4 curriculum=false" ;;
-  *) echo "stage must be 1, 2 or 3" >&2; exit 2 ;;
+  4) export ZOO_OUT=${STAGE4_OUT:-runs/stage4} TIMESTEPS=${TIMESTEPS:-700000} CHECKPOINT_FREQ=100000 \
+       INIT_FROM="${STAGE4_FROM:-zoo/{map}/{variant}}" \
+       ZOO_RUNS=${ZOO_RUNS:-"A:rl-msg A:rl-no-msg A:rl-intention"} \
+       ZOO_SET="env.episode_steps=1500 env.init_battery=[0.15,1.0] mix.episodes=[0,2,4,6] mix.env.episode_steps=400 mix.env.init_battery=[0.05,0.4] $SHARED learning_rate=3e-4 curriculum=false" ;;
+  *) echo "stage must be 1, 2, 3 or 4" >&2; exit 2 ;;
 esac
 exec zoo/train_parallel.sh "$SECONDS_PER_CALL" $RESUME
