@@ -8,7 +8,29 @@
 # Stage 2 (patrol + recharge, from the stage-1 weights): 3,300 s for all six (A/rl-no-msg
 # started a minute later, 3,210 s).
 #
-# v4 (map A only; B, C and D keep v2 below): the v3 entries below, then stage 3 of
+# B, C and D v4 (2026-12-01): the three stages of zoo/train_stages.sh, three runs side by side,
+#   export STAGE1_OUT=runs/v5_stage1 STAGE2_OUT=runs/v5_zoo STAGE3_OUT=runs/v5_stage3
+#   export STAGE1_RUNS="B:rl-msg C:rl-msg D:rl-msg" ZOO_RUNS="B:rl-msg C:rl-msg D:rl-msg"
+#   TIMESTEPS=1500000 zoo/train_stages.sh 1 2400
+#   TIMESTEPS=2000000 zoo/train_stages.sh 2 3000
+#   TIMESTEPS=800000 zoo/train_stages.sh 3 1500
+# (each ran to its step budget), every drill checkpoint validated with
+#   patrolsb3 zoo validate runs/v5_stage3/<map>/rl-msg/MaskableRecurrentPPO_seed0
+# and the best exported with --cpu-hours = stage 1 (ps, 0.26) + stage 2 and 3 (their
+# cpu_time.csv, stage 3 up to the checkpoint), --episodes 10 --steps 14400 --seed 0, the
+# stage-1/2 curves, commands and stage 2's cpu_time.csv copied beside it.
+# A v5 (rl-msg, rl-intention; rl-no-msg keeps v4): stage 4 from the v4 entries,
+#   ZOO_RUNS="A:rl-msg" TIMESTEPS=1228800 STAGE4_OUT=runs/mix zoo/train_stages.sh 4 5400
+#   ZOO_RUNS="A:rl-no-msg A:rl-intention" STAGE4_OUT=runs/mix zoo/train_stages.sh 4 3000
+# (the same commands as these, run by hand), validated the same way, the best exported with
+#   patrolsb3 zoo export runs/mix/A/<variant>/MaskableRecurrentPPO_seed0 --checkpoint <best> \
+#     --zoo-dir runs/zoo_mix --episodes 10 --steps 14400 --seed 0     # CPU hours measured
+# and copied into zoo/A/<variant> (the v4 stage-3 curve and command renamed *_stage3); the
+# sampled evaluation: patrolsb3.zoo.write_eval(copy, steps=3600, deterministic=False) on a
+# scratch copy, eval_sampled.json copied beside; the comparison as at the end of this script
+# (its heuristics reused from zoo/comparison/results.json).
+#
+# v4 (map A only; B, C and D were v2 then): the v3 entries below, then stage 3 of
 # zoo/train_stages.sh (the recharge drill), three runs side by side, started from the v3 zoo
 # entries (zoo/A/<variant>, now kept as curve_stage2.csv / command_stage2.txt) and run to
 # 614,400 agent-steps, then resumed to 1,228,800 (command.txt has both calls; rl-no-msg's
