@@ -8,20 +8,9 @@ ranked: fewest battery failures first, then the lowest AVG^h.
 """
 from __future__ import annotations
 
-import json
-import zipfile
 from pathlib import Path
 
 import numpy as np
-
-
-def saved_steps(path) -> int | None:
-    """Agent-steps an SB3 model file was saved at (its ``data`` entry), None if it does not say."""
-    try:
-        with zipfile.ZipFile(path) as archive:
-            return int(json.loads(archive.read("data"))["num_timesteps"])
-    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
-        return None
 
 
 def run_checkpoints(run_dir) -> list[Path]:
@@ -31,11 +20,10 @@ def run_checkpoints(run_dir) -> list[Path]:
     Raises:
         FileNotFoundError: a folder with no checkpoint and no model.zip.
     """
-    from .sb3.train import CHECKPOINT_RE, checkpoints_by_steps
+    from .sb3.train import checkpoints_by_steps, model_steps
     run_dir = Path(run_dir)
     paths = checkpoints_by_steps(run_dir)
-    steps = {int(CHECKPOINT_RE.search(p.name).group(1)) for p in paths}
-    if (run_dir / "model.zip").is_file() and saved_steps(run_dir / "model.zip") not in steps:
+    if (run_dir / "model.zip").is_file() and model_steps(run_dir / "model.zip") not in map(model_steps, paths):
         paths.append(run_dir / "model.zip")
     if not paths:
         raise FileNotFoundError(f"{run_dir}: no checkpoints/model_<steps>_steps.zip and no model.zip; "

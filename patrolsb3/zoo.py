@@ -298,7 +298,8 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None) -
         config["budget"]["cpu_hours_source"] = "given (--cpu-hours)"
     elif (measured := cpu_hours_of(source)) is not None:
         config["budget"]["cpu_hours"] = round(measured, 3)
-        config["budget"]["cpu_hours_source"] = "measured (this run's cpu_time.csv) + the cpu_hours its warm-start source recorded, if any"
+        config["budget"]["cpu_hours_source"] = ("measured (this run's cpu_time.csv) + the cpu_hours "
+                                                "its warm-start source recorded, if any")
     warm = (config.get("init_from") or {}).get("timesteps")
     if warm:  # a warm-started run: its budget includes the run it started from
         config["budget"]["timesteps_this_run"] = int(model.num_timesteps)

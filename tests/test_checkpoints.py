@@ -6,9 +6,9 @@ import pytest
 import torch
 
 from patrolsb3 import cli, zoo
-from patrolsb3.checkpoints import rank, run_checkpoints, saved_steps, validate
+from patrolsb3.checkpoints import rank, run_checkpoints, validate
 from patrolsb3.core import load_map, make_config, reset_state
-from patrolsb3.sb3.train import train
+from patrolsb3.sb3.train import model_steps, train
 
 torch.set_num_threads(1)
 
@@ -31,7 +31,7 @@ def test_every_checkpoint_in_step_order_then_the_final_model(run, tmp_path):
     steps = [int(p.name.split("_")[1]) for p in paths]
     assert len(steps) >= 2 and steps == sorted(steps) and steps[-1] == 800
     assert all(p.name == f"model_{s}_steps.zip" for p, s in zip(paths, steps))
-    assert saved_steps(run / "model.zip") == 800          # the same model as the last checkpoint: once
+    assert model_steps(run / "model.zip") == 800          # the same model as the last checkpoint: once
     copy = tmp_path / "copy"
     shutil.copytree(run, copy)
     (copy / "checkpoints" / "model_800_steps.zip").unlink()

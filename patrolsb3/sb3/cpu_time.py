@@ -1,10 +1,10 @@
 """The CPU time a training run spent, measured by the run itself: ``<run>/cpu_time.csv``.
 
 One row when each rollout starts (the update of the rollout before it done) and one when the
-run stops, with its last checkpoint: the agent-steps reached and the CPU seconds of the training process (every thread, ``time.process_time``) spent
-in ``learn()`` so far, counted across ``--resume`` calls. A resumed run first cuts the rows past
-the checkpoint it resumes from, so the file always describes the path that led to its
-checkpoints. A warm-started run (``--init-from``) records the CPU hours of its source in
+run stops, with its last checkpoint: the agent-steps reached and the CPU seconds of the
+training process (every thread, ``time.process_time``) spent in ``learn()`` so far, counted
+across ``--resume`` calls. A resumed run first cuts the rows past the checkpoint it resumes
+from, so the file always describes the path that led to its checkpoints. A warm-started run (``--init-from``) records the CPU hours of its source in
 ``config.yml`` (``init_from.cpu_hours``), so :func:`cpu_hours_of` adds up a chain of stages,
 which is what ``patrolsb3 zoo export`` records as the entry's budget.
 """
@@ -50,22 +50,11 @@ def restart_at(run_dir, timesteps: int) -> float:
     return rows[-1][1] if rows else 0.0
 
 
-def model_steps(model_path) -> int | None:
-    """Agent-steps of a checkpoint from its name (``model_<steps>_steps.zip``); for a run's
-    ``model.zip`` the last row of its cpu_time.csv; None when neither tells."""
-    from .train import CHECKPOINT_RE
-    model_path = Path(model_path)
-    if m := CHECKPOINT_RE.search(model_path.name):
-        return int(m.group(1))
-    rows = read_rows(model_path.parent)
-    return rows[-1][0] if rows else None
-
-
 def cpu_hours_of(model_path) -> float | None:
     """CPU hours spent to train a checkpoint (or a run's model.zip), every warm-start stage
     before it included; None when a part of that chain was not measured (a run older than
     this record, or a source without a figure)."""
-    from .train import run_folder_of
+    from .train import model_steps, run_folder_of
     run_dir = run_folder_of(model_path)
     steps = model_steps(model_path)
     own = cpu_seconds_at(run_dir, steps) if steps is not None else None

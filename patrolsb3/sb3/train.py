@@ -17,8 +17,10 @@ in the hyperparameters and converted per env step (``gamma ** (1 / phases_per_st
 """
 from __future__ import annotations
 
+import json
 import re
 import sys
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -52,6 +54,20 @@ def checkpoints_by_steps(run_dir) -> list[Path]:
     found = sorted((int(m.group(1)), p) for p in (Path(run_dir) / "checkpoints").glob("model_*_steps.zip")
                    if (m := CHECKPOINT_RE.search(p.name)))
     return [p for _, p in found]
+
+
+def model_steps(model_path) -> int | None:
+    """Agent-steps a model file was saved at: from a checkpoint's name
+    (``model_<steps>_steps.zip``), else from the SB3 zip's own ``data`` record (a run's
+    ``model.zip``); None when neither tells."""
+    model_path = Path(model_path)
+    if m := CHECKPOINT_RE.search(model_path.name):
+        return int(m.group(1))
+    try:
+        with zipfile.ZipFile(model_path) as archive:
+            return int(json.loads(archive.read("data"))["num_timesteps"])
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
+        return None
 
 
 def newest_checkpoint(run_dir: Path) -> Path | None:
@@ -278,7 +294,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
 
     from ..core.maps import load_map
     from .callbacks import LearningCurveCallback, PaperMetricsEvalCallback
-    from .cpu_time import CpuTimeCallback, restart_at  # noqa: PLC0415 - next to the other callbacks
+    from .cpu_time import CpuTimeCallback, restart_at
     from .curriculum import CurriculumCallback
     from .variants import variant_overrides
     from .vec_env import DEFAULT_AGENTS, make_vec_env
