@@ -168,3 +168,12 @@ def test_a_shipped_map_loaded_by_path_keeps_its_letter_and_paper_values():
     spec = load_map(str(MAPS_DIR / "map_b.txt"))
     assert spec.name == "B"
     assert make_config(spec.name).c_pbb == 0.5
+
+
+def test_nearest_station_steps_and_first_move():
+    spec = parse_map("S.#\n..#\n...\n#.S")
+    cells = np.array([[0, 1, 4, 7]])                     # (0,0) station, (0,1), (1,1), (2,1)
+    steps, first = spec.nearest_station(cells)
+    assert steps.tolist() == [[0, 1, 2, 2]]
+    # ties go to the first action in order: (1,1) Up before Left, (2,1) Down before Right
+    assert first.tolist() == [[STAY, LEFT, UP, DOWN]]

@@ -7,7 +7,7 @@ import pytest
 from patrolsb3.core import make_config
 from patrolsb3.core.maps import STAY
 from patrolsb3.core.reward import (battery_reward, collision_reward, difference_reward,
-                                   normalised_idleness, team_patrol_reward)
+                                   home_potential, normalised_idleness, team_patrol_reward)
 from patrolsb3.core.step import step
 
 from conftest import deterministic_config, place
@@ -149,3 +149,49 @@ def test_an_agent_saved_by_its_arrival_gets_the_low_battery_penalty_not_the_fail
     info = step(spec, cfg, state, [[2]])                  # Left, onto the station
     assert info.swap_started[0, 0] and not info.battery_failed[0, 0]
     assert info.reward_battery[0, 0] == pytest.approx(-(cfg.c_pbb + cfg.c_pbm), rel=1e-6)
+
+
+def test_home_potential_by_hand():
+    cfg = make_config(c_home=50.0)               # b_l = 110: urgency from 220 units down
+    battery = np.array([[550.0, 220.0, 165.0, 110.0, 0.0]])
+    steps = np.array([[6, 6, 6, 6, 6]])
+    expected = [0.0, 0.0, -50 * 0.25 * 0.25, -50 * 0.25 * 0.5, -50 * 0.25 * 1.0]
+    assert home_potential(steps, battery, cfg, 24.0)[0] == pytest.approx(expected)
+    assert home_potential(np.zeros((1, 5)), battery, cfg, 24.0)[0] == pytest.approx([0.0] * 5)
+
+
+def test_home_shaping_is_off_by_default(line_map):
+    spec = line_map
+    cfg = deterministic_config(max_agents=1)
+    state = place(spec, cfg, [(0, 3)], battery=[20.0])
+    info = step(spec, cfg, state, np.array([[2]]))   # Left, toward the station
+    assert info.reward_home[0, 0] == 0.0
+
+
+def test_home_shaping_in_a_step_by_hand(line_map):
+    spec = line_map                              # "S.....", 1 x 6: H + W = 7
+    cfg = deterministic_config(max_agents=2, c_home=70.0)
+    state = place(spec, cfg, [(0, 3), (0, 4)], battery=[110.0, 110.0])
+    info = step(spec, cfg, state, np.array([[2, 3]]))  # slot 0 Left (home), slot 1 Right (away)
+    urgency_before, urgency_after = 110 / 220, 111 / 220  # one unit drained
+    toward = -70 * (2 / 7) * urgency_after + 70 * (3 / 7) * urgency_before
+    away = -70 * (5 / 7) * urgency_after + 70 * (4 / 7) * urgency_before
+    assert info.reward_home[0] == pytest.approx([toward, away])
+    assert toward > 0 > away
+    assert info.reward[0] == pytest.approx(info.reward_patrol[0] + info.reward_battery[0]
+                                           + info.reward_home[0])
+
+
+def test_home_shaping_pays_back_the_trip_on_arrival_and_nothing_on_failure(line_map):
+    spec = line_map
+    cfg = deterministic_config(max_agents=2, c_home=70.0)
+    state = place(spec, cfg, [(0, 1), (0, 4)], battery=[50.0, 1.0])
+    info = step(spec, cfg, state, np.array([[2, 2]]))  # slot 0 onto the station, slot 1 runs dry
+    assert info.swap_started[0, 0] and info.battery_failed[0, 1]
+    assert info.reward_home[0, 0] == pytest.approx(70 * (1 / 7) * (170 / 220))
+    assert info.reward_home[0, 1] == 0.0
+
+
+def test_a_negative_home_shaping_weight_is_refused():
+    with pytest.raises(ValueError, match="c_home must be >= 0, got -1"):
+        make_config(c_home=-1.0)

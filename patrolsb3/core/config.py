@@ -60,6 +60,10 @@ class EnvConfig:
     """Slope of the low-battery penalty: -(c_pbb + c_pbm (b_l - b) / b_l)."""
     c_pc: float = 1.0
     """Penalty to each agent in a collision event."""
+    c_home: float = 0.0
+    """OURS: weight of the home shaping, a difference of potentials that pulls an agent with
+    a low battery toward the station (``core/reward.py``: ``home_potential``). 0, the
+    paper's reward, by default."""
 
     local_idleness: bool = False
     """OURS: append to the actor's vector the normalised idleness of the cell each move leads
@@ -93,6 +97,8 @@ class EnvConfig:
             raise ValueError(f"message_timing must be one of {MESSAGE_TIMINGS}, got {self.message_timing!r}")
         if self.invalid_action not in INVALID_ACTION_MODES:
             raise ValueError(f"invalid_action must be one of {INVALID_ACTION_MODES}, got {self.invalid_action!r}")
+        if self.c_home < 0:
+            raise ValueError(f"c_home must be >= 0, got {self.c_home}")
         if self.episode_steps < 1:
             raise ValueError(f"episode_steps must be >= 1, got {self.episode_steps}")
         if not 0.0 <= self.p_dyn_max <= 1.0:

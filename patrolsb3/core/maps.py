@@ -99,6 +99,22 @@ class MapSpec:
         """First action of a shortest path from cell ``a`` to cell ``b`` (broadcasting arrays)."""
         return self.next_action[self.free_index[a], self.free_index[b]]
 
+    def nearest_station(self, cells) -> tuple[np.ndarray, np.ndarray]:
+        """Shortest-path steps to the nearest station and the first move of such a path.
+
+        Args:
+            cells: cell indices of free cells, any shape S.
+
+        Returns:
+            steps (S) int32 (0 on a station) and first move (S) int8 (STAY on a station).
+        """
+        here = self.free_index[np.asarray(cells)]                               # (S)
+        station_free = self.free_index[self.stations]                            # (n_stations,)
+        to_station = self.dist[here][..., station_free]                          # (S, n_stations)
+        nearest = np.argmin(to_station, axis=-1)                                 # (S)
+        steps = np.take_along_axis(to_station, nearest[..., None], axis=-1)[..., 0]
+        return steps, self.next_action[here, station_free[nearest]]
+
     def rowcol(self, cells) -> tuple[np.ndarray, np.ndarray]:
         """Row and column arrays of cell indices."""
         return np.divmod(np.asarray(cells), self.shape[1])

@@ -63,12 +63,7 @@ def home_features(spec: MapSpec, cfg: EnvConfig, state: State) -> np.ndarray:
         (E, A, 7) float32, zeros for inactive slots.
     """
     H, W = spec.shape
-    here = spec.free_index[state.pos]                                         # (E, A)
-    station_free = spec.free_index[spec.stations]                             # (S,)
-    to_station = spec.dist[here][..., station_free]                           # (E, A, S)
-    nearest = np.argmin(to_station, axis=-1)                                  # (E, A)
-    steps_home = np.take_along_axis(to_station, nearest[..., None], axis=-1)[..., 0]
-    first = spec.next_action[here, station_free[nearest]]                     # (E, A)
+    steps_home, first = spec.nearest_station(state.pos)                       # (E, A), (E, A)
     out = np.zeros(state.pos.shape + (7,), dtype=np.float32)
     out[..., 0] = np.minimum(steps_home / (H + W), 1.0)
     out[..., 1] = np.clip((state.battery - steps_home * cfg.drain[1]) / cfg.b_max, -1.0, 1.0)

@@ -1,4 +1,5 @@
-"""The paper's rewards (Eq. 1-4): R = R_p + R_b + R_c per agent per step."""
+"""The paper's rewards (Eq. 1-4): R = R_p + R_b + R_c per agent per step, and our optional
+home shaping R_h (``cfg.c_home``, 0 by default)."""
 from __future__ import annotations
 
 import numpy as np
@@ -68,3 +69,27 @@ def battery_reward(battery: np.ndarray, cfg: EnvConfig) -> np.ndarray:
 def collision_reward(collided: np.ndarray, cfg: EnvConfig) -> np.ndarray:
     """R_c: -c_pc to every agent in a collision event; (E, A)."""
     return np.where(collided, -cfg.c_pc, 0.0)
+
+
+def home_potential(steps_home: np.ndarray, battery: np.ndarray, cfg: EnvConfig,
+                   scale: float) -> np.ndarray:
+    """OURS: Phi = -c_home * (steps home / scale) * urgency, urgency = clip((2 b_l - b) / (2 b_l), 0, 1).
+
+    The home shaping of an agent that stays active is R_h = Phi(after the step) - Phi(before):
+    once its battery is under twice b_l, each step toward the station earns about
+    c_home * urgency / scale and each step away costs as much, and arriving on the station
+    (0 steps home) pays back what the trip cost. A difference of potentials (Ng et al. 1999)
+    leaves the best policy unchanged up to discounting; it only makes the way home found
+    sooner. An agent that fails gets no R_h that step (R_b's -c_pb alone).
+
+    Args:
+        steps_home: (E, A) shortest-path steps to the nearest station.
+        battery: (E, A) battery units.
+        cfg: environment parameters (c_home, b_low).
+        scale: distance normaliser, H + W of the map.
+
+    Returns:
+        (E, A) potential (<= 0).
+    """
+    urgency = np.clip((2.0 * cfg.b_low - battery) / (2.0 * cfg.b_low), 0.0, 1.0)
+    return -cfg.c_home * (steps_home / scale) * urgency

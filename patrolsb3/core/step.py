@@ -31,8 +31,8 @@ import numpy as np
 from .config import EnvConfig
 from .maps import ACTION_NAMES, STAY, MapSpec
 from .masks import move_allowed, station_cells
-from .reward import (battery_reward, collision_reward, difference_reward, normalised_idleness,
-                     team_patrol_reward)
+from .reward import (battery_reward, collision_reward, difference_reward, home_potential,
+                     normalised_idleness, team_patrol_reward)
 from .state import ACTIVE, FAILED, SWAPPING, State
 
 
@@ -48,6 +48,7 @@ class StepInfo:
     reward_patrol: np.ndarray   # (E, A) float64 R_p
     reward_battery: np.ndarray  # (E, A) float64 R_b
     reward_collision: np.ndarray  # (E, A) float64 R_c
+    reward_home: np.ndarray     # (E, A) float64 R_h, our home shaping (0 unless cfg.c_home > 0)
     acted: np.ndarray           # (E, A) bool, slot was active at the start of the step
     pushed: np.ndarray          # (E, A) bool, moved by the wind instead of its move
     collided: np.ndarray        # (E, A) bool, took part in a collision event
@@ -171,6 +172,10 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
     # 2. moves, checked against the mask
     moves = check_moves(spec, cfg, state, moves)
     pos = state.pos
+    shaping = compute_reward and cfg.c_home > 0
+    if shaping:
+        home_scale = float(sum(spec.shape))
+        phi_before = home_potential(spec.nearest_station(pos)[0], state.battery, cfg, home_scale)
     # 3. pushes by the environment
     pushed = acted & (rng.random((E, A)) < state.p_dyn)
     push_dir = rng.integers(0, 4, size=(E, A))
@@ -221,13 +226,17 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
         reward_patrol = np.where(acted, cfg.c_rp * team[:, None] + cfg.difference_weight * d, 0.0)
         reward_battery = np.where(acted, reward_battery, 0.0)
         reward_collision = np.where(acted, collision_reward(collided, cfg), 0.0)
-        reward = reward_patrol + reward_battery + reward_collision
+        reward_home = np.zeros((E, A))
+        if shaping:
+            phi_after = home_potential(spec.nearest_station(state.pos)[0], state.battery, cfg, home_scale)
+            reward_home = np.where(acted & ~battery_failed & ~fault_failed, phi_after - phi_before, 0.0)
+        reward = reward_patrol + reward_battery + reward_collision + reward_home
     else:
         team = np.full(E, np.nan)
-        reward = reward_patrol = reward_battery = reward_collision = np.zeros((E, A))
+        reward = reward_patrol = reward_battery = reward_collision = reward_home = np.zeros((E, A))
     return StepInfo(
         reward=reward, reward_patrol=reward_patrol, reward_battery=reward_battery,
-        reward_collision=reward_collision, acted=acted, pushed=pushed, collided=collided,
+        reward_collision=reward_collision, reward_home=reward_home, acted=acted, pushed=pushed, collided=collided,
         collisions=collisions, swap_started=arrived, swap_battery=swap_battery,
         swap_ended=swap_ended, battery_failed=battery_failed, fault_failed=fault_failed,
         team_patrol=team, mean_idleness=state.idle.mean(axis=1),
