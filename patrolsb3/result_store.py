@@ -13,18 +13,37 @@ import json
 import os
 from pathlib import Path
 
-from .core.config import ENV_VERSION
+import dataclasses
+
+from .core.config import ENV_VERSION, EnvConfig
 
 PROTOCOL_KEYS = ("strategy", "map", "n_agents", "episodes", "tests", "steps", "seed", "faults", "env")
 """Result fields that must match for a stored result to stand for a new run."""
 
 
+def env_with_defaults(env) -> dict | None:
+    """A result's env settings with every EnvConfig field it lacks at its default.
+
+    A field added to EnvConfig after a result was stored (``c_home``, say) keeps the old
+    rules at its default, so the old result stands for a run with the default.
+    """
+    if not isinstance(env, dict):
+        return env
+    defaults = {f.name: f.default for f in dataclasses.fields(EnvConfig)
+                if f.default is not dataclasses.MISSING}
+    defaults = {k: list(v) if isinstance(v, tuple) else v for k, v in defaults.items()}
+    return {**defaults, **env}
+
+
 def protocol(result: dict) -> tuple:
     """The fields of a result (or of a request shaped like one) that decide whether it can be
-    reused: those of :data:`PROTOCOL_KEYS`, the action mode for zoo models (heuristics ignore
-    it) and the env version."""
+    reused: those of :data:`PROTOCOL_KEYS` (env settings with defaults filled in:
+    :func:`env_with_defaults`), the action mode for zoo models (heuristics ignore it) and the
+    env version."""
     learned = str(result["strategy"]).startswith("zoo:")
-    return (json.dumps([result.get(k) for k in PROTOCOL_KEYS], sort_keys=True),
+    fields = {k: result.get(k) for k in PROTOCOL_KEYS}
+    fields["env"] = env_with_defaults(fields["env"])
+    return (json.dumps([fields[k] for k in PROTOCOL_KEYS], sort_keys=True),
             bool(result.get("deterministic", True)) if learned else None,
             result.get("env_version", ENV_VERSION))
 

@@ -27,6 +27,17 @@ def test_a_stored_result_stands_only_for_the_same_protocol(tmp_path):
     assert len(json.loads((tmp_path / "results.json").read_text())) == 1
 
 
+def test_a_result_stored_before_an_env_field_existed_stands_for_its_default(tmp_path):
+    store = ResultStore(tmp_path)
+    result = evaluate("CR", "A", 2, episodes=1, steps=30, seed=1, progress=False)
+    old = {**result, "env": {k: v for k, v in result["env"].items() if k != "c_home"}}
+    store.add(old)                                                # as written before c_home existed
+    assert store.find(result) is not None                         # c_home at its default 0
+    assert store.find({**result, "env": {**result["env"], "c_home": 50.0}}) is None
+    store.add(result)                                             # the same protocol: replaces it
+    assert len(json.loads((tmp_path / "results.json").read_text())) == 1
+
+
 def test_a_broken_results_file_is_named(tmp_path):
     (tmp_path / "results.json").write_text("{not json")
     with pytest.raises(ValueError, match="results.json is not a results file"):

@@ -19,6 +19,17 @@
 # and the best exported with --cpu-hours = stage 1 (ps, 0.26) + stage 2 and 3 (their
 # cpu_time.csv, stage 3 up to the checkpoint), --episodes 10 --steps 14400 --seed 0, the
 # stage-1/2 curves, commands and stage 2's cpu_time.csv copied beside it.
+# B and D v6 (2026-12-01, later that day): stage 2h of zoo/train_stages.sh from the v4
+# stage-1 weights (runs/v5_stage1), run by hand with the same settings:
+#   STAGE1_OUT=runs/v5_stage1 STAGE2H_OUT=runs/v6_home TIMESTEPS=2700000 zoo/train_stages.sh 2h 6000
+# (run ids ent0.002 instead of MaskableRecurrentPPO_seed0; B ran to 1.5 M, was resumed to
+# 2.7 M and then 4.0 M; D ran to 2.7 M), every checkpoint validated with
+#   patrolsb3 zoo validate runs/v6_home/<map>/rl-msg/ent0.002
+# the best ones cross-checked greedy on 8 episodes x 3,000 steps, n = 1, 3, 5, seed 11, and
+# the chosen one exported (B 1,805,280, D 1,100,000) with --cpu-hours = stage 1 (ps, 0.26) +
+# this run's cpu_time.csv up to the checkpoint (B 0.34, D 0.20); v4's stage-2 files removed
+# from the entries (the v4 entries are in the git history), the sampled evaluation and the
+# comparison as for A v5 below.
 # A v5 (rl-msg, rl-intention; rl-no-msg keeps v4): stage 4 from the v4 entries,
 #   ZOO_RUNS="A:rl-msg" TIMESTEPS=1228800 STAGE4_OUT=runs/mix zoo/train_stages.sh 4 5400
 #   ZOO_RUNS="A:rl-no-msg A:rl-intention" STAGE4_OUT=runs/mix zoo/train_stages.sh 4 3000

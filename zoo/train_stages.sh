@@ -6,6 +6,7 @@
 #   zoo/train_stages.sh 2 SECONDS [--resume]   # stage 2: patrol + recharge, STAGE2_OUT (runs/zoo)
 #   zoo/train_stages.sh 3 SECONDS [--resume]   # stage 3: recharge drill, STAGE3_OUT (runs/stage3)
 #   zoo/train_stages.sh 4 SECONDS [--resume]   # stage 4: drill + long episodes mixed, STAGE4_OUT (runs/stage4)
+#   zoo/train_stages.sh 2h SECONDS [--resume]  # stages 2-4 in one: mixed + home shaping, STAGE2H_OUT (runs/stage2h)
 #
 # Each stage after the first starts from the weights of the stage before it (its run folder:
 # model.zip, or the newest checkpoint of a run stopped by time).
@@ -21,11 +22,14 @@
 # eight parallel episodes (teams 1, 1, 2, 4) are drill episodes, the other four (teams 1, 1, 3,
 # 5) last 1,500 steps from 15-100 %, so the patrol improves on long episodes while the
 # recharge keeps being practised; choose its checkpoint with `patrolsb3 zoo validate` too.
+# Stage 2h (B and D's v6) replaces stages 2-4: from the stage-1 weights, stage 4's mix of drill
+# and long episodes with the home shaping env.c_home=50 (core/reward.py), which pays a
+# low-battery agent for each step toward the station; without it B never found the station.
 # STAGE1_RUNS / ZOO_RUNS pick the runs (map:variant); the shared settings below apply to every
 # variant alike.
 set -euo pipefail
-STAGE=${1:?usage: zoo/train_stages.sh 1|2|3|4 SECONDS [--resume]}
-SECONDS_PER_CALL=${2:?usage: zoo/train_stages.sh 1|2|3|4 SECONDS [--resume]}
+STAGE=${1:?usage: zoo/train_stages.sh 1|2|3|4|2h SECONDS [--resume]}
+SECONDS_PER_CALL=${2:?usage: zoo/train_stages.sh 1|2|3|4|2h SECONDS [--resume]}
 RESUME=${3:-}
 # env.local_idleness and env.c_d (the difference reward's weight, paper 50 / 5 = 10) are this
 # zoo's changes to the observation and the reward scale; zoo/README.md says why
@@ -47,6 +51,10 @@ case "$STAGE" in
        INIT_FROM="${STAGE4_FROM:-zoo/{map}/{variant}}" \
        ZOO_RUNS=${ZOO_RUNS:-"A:rl-msg A:rl-no-msg A:rl-intention"} \
        ZOO_SET="env.episode_steps=1500 env.init_battery=[0.15,1.0] mix.episodes=[0,2,4,6] mix.env.episode_steps=400 mix.env.init_battery=[0.05,0.4] $SHARED learning_rate=3e-4 curriculum=false" ;;
-  *) echo "stage must be 1, 2, 3 or 4" >&2; exit 2 ;;
+  2h) export ZOO_OUT=${STAGE2H_OUT:-runs/stage2h} TIMESTEPS=${TIMESTEPS:-2700000} CHECKPOINT_FREQ=100000 \
+       INIT_FROM="${STAGE1_OUT:-runs/stage1}/{map}/{variant}/MaskableRecurrentPPO_seed0" \
+       ZOO_RUNS=${ZOO_RUNS:-"B:rl-msg D:rl-msg"} \
+       ZOO_SET="env.episode_steps=1500 env.init_battery=[0.15,1.0] mix.episodes=[0,2,4,6] mix.env.episode_steps=400 mix.env.init_battery=[0.05,0.4] env.c_home=50 $SHARED learning_rate=3e-4 curriculum=false" ;;
+  *) echo "stage must be 1, 2, 3, 4 or 2h" >&2; exit 2 ;;
 esac
 exec zoo/train_parallel.sh "$SECONDS_PER_CALL" $RESUME
