@@ -13,8 +13,6 @@ import json
 import os
 from pathlib import Path
 
-import dataclasses
-
 from .core.config import ENV_VERSION, EnvConfig
 
 PROTOCOL_KEYS = ("strategy", "map", "n_agents", "episodes", "tests", "steps", "seed", "faults", "env")
@@ -27,12 +25,7 @@ def env_with_defaults(env) -> dict | None:
     A field added to EnvConfig after a result was stored (``c_home``, say) keeps the old
     rules at its default, so the old result stands for a run with the default.
     """
-    if not isinstance(env, dict):
-        return env
-    defaults = {f.name: f.default for f in dataclasses.fields(EnvConfig)
-                if f.default is not dataclasses.MISSING}
-    defaults = {k: list(v) if isinstance(v, tuple) else v for k, v in defaults.items()}
-    return {**defaults, **env}
+    return {**EnvConfig().to_dict(), **env} if isinstance(env, dict) else env
 
 
 def protocol(result: dict) -> tuple:

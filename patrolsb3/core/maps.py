@@ -110,7 +110,7 @@ class MapSpec:
         """
         here = self.free_index[np.asarray(cells)]                               # (S)
         station_free = self.free_index[self.stations]                            # (n_stations,)
-        to_station = self.dist[here][..., station_free]                          # (S, n_stations)
+        to_station = self.dist[here[..., None], station_free]                    # (S, n_stations)
         nearest = np.argmin(to_station, axis=-1)                                 # (S)
         steps = np.take_along_axis(to_station, nearest[..., None], axis=-1)[..., 0]
         return steps, self.next_action[here, station_free[nearest]]

@@ -236,8 +236,8 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
         reward = reward_patrol = reward_battery = reward_collision = reward_home = np.zeros((E, A))
     return StepInfo(
         reward=reward, reward_patrol=reward_patrol, reward_battery=reward_battery,
-        reward_collision=reward_collision, reward_home=reward_home, acted=acted, pushed=pushed, collided=collided,
-        collisions=collisions, swap_started=arrived, swap_battery=swap_battery,
+        reward_collision=reward_collision, reward_home=reward_home, acted=acted, pushed=pushed,
+        collided=collided, collisions=collisions, swap_started=arrived, swap_battery=swap_battery,
         swap_ended=swap_ended, battery_failed=battery_failed, fault_failed=fault_failed,
         team_patrol=team, mean_idleness=state.idle.mean(axis=1),
         max_idleness=state.idle.max(axis=1), truncated=state.t >= cfg.episode_steps,
