@@ -1,7 +1,10 @@
 """patrolsb3.core.masks: move masks on a non-square map, and the composite (message, move) masks."""
 import numpy as np
 
-from patrolsb3.core.masks import action_mask, composite_action_mask, move_allowed
+from patrolsb3.bench.env import random_valid_moves
+from patrolsb3.core import load_map, make_config, step
+from patrolsb3.core.masks import action_mask, composite_action_mask, move_allowed, return_threshold
+from patrolsb3.core.observe import actor_observation
 from patrolsb3.core.state import FAILED, SWAPPING, reset_state
 
 from conftest import cell, deterministic_config, place
@@ -122,3 +125,85 @@ def test_vectorised_mask_matches_the_rule_on_crowded_random_states():
         moves = rng.integers(0, 5, state.pos.shape)
         assert np.array_equal(move_allowed(spec, state, moves),
                               np.take_along_axis(mask, moves[..., None], axis=-1)[..., 0])
+
+
+# --- env.return_guard: the learned policy's shield (OURS) ------------------------------------
+
+def _due(cfg, spec, r, c):
+    """The battery (units) at which an agent on (r, c) is just due home."""
+    return float(return_threshold(spec, cfg)[cell(spec, r, c)])
+
+
+def test_return_threshold_is_the_trip_home_with_margin_plus_b_low(line_map):
+    spec = line_map                                                    # "S....."
+    cfg = make_config(drain=(0.9, 1.1), p_dyn_max=0.04, push_drain_factor=1.5)
+    margin = (1 + 0.04 * 0.5) * (1 + 2 * 0.04) * 1.25
+    threshold = return_threshold(spec, cfg)
+    assert threshold[cell(spec, 0, 0)] == cfg.b_low                    # on the station
+    assert np.isclose(threshold[cell(spec, 0, 4)], 4 * 1.1 * margin + cfg.b_low)
+
+
+def test_return_guard_is_off_by_default(middle_station_map):
+    spec = middle_station_map                                          # "..S.."
+    cfg = deterministic_config(max_agents=1)
+    state = place(spec, cfg, [(0, 0)], battery=[1.0])
+    assert not cfg.return_guard
+    assert (action_mask(spec, state, cfg) == action_mask(spec, state)).all()
+
+
+def test_return_guard_keeps_only_moves_home_once_due(middle_station_map):
+    spec = middle_station_map                                          # "..S.."
+    cfg = deterministic_config(max_agents=2, return_guard=True)
+    due_left, due_right = _due(cfg, spec, 0, 0), _due(cfg, spec, 0, 4)
+    state = place(spec, cfg, [(0, 0), (0, 4)], battery=[due_left, due_right])
+    mask = action_mask(spec, state, cfg)[0]
+    assert list(mask[0]) == [False, False, False, True, False]         # Right, toward S
+    assert list(mask[1]) == [False, False, True, False, False]         # Left, toward S
+    state.battery[0] += 0.5                                            # just above: free again
+    assert (action_mask(spec, state, cfg) == action_mask(spec, state)).all()
+
+
+def test_return_guard_sends_a_pushed_arrival_off_the_station_and_back(middle_station_map):
+    spec = middle_station_map
+    cfg = deterministic_config(max_agents=1, return_guard=True)
+    state = place(spec, cfg, [(0, 2)], battery=[cfg.b_low])            # on S, not swapping
+    assert list(action_mask(spec, state, cfg)[0, 0]) == [False, False, True, True, False]
+
+
+def test_return_guard_leaves_a_blocked_agent_its_plain_mask(line_map):
+    spec = line_map                                                    # "S....."
+    cfg = deterministic_config(max_agents=2, return_guard=True)
+    state = place(spec, cfg, [(0, 2), (0, 1)], battery=[_due(cfg, spec, 0, 2), cfg.b_max])
+    plain = action_mask(spec, state)[0, 0]
+    assert list(plain) == [False, False, False, True, True]            # Left is occupied
+    assert (action_mask(spec, state, cfg)[0, 0] == plain).all()
+
+
+def test_return_guard_reaches_the_composite_mask_and_the_observation(middle_station_map):
+    spec = middle_station_map
+    cfg = deterministic_config(max_agents=1, return_guard=True)
+    state = place(spec, cfg, [(0, 0)], battery=[_due(cfg, spec, 0, 0)])
+    _, move = composite_action_mask(spec, cfg, state, message_phase=False)
+    _, vector = actor_observation(spec, cfg, state, phase=1)
+    assert list(move[0, 0]) == [False, False, False, True, False]
+    assert list(vector[0, 0, 1:6]) == [0, 0, 0, 1, 0]
+
+
+def test_random_walkers_behind_the_guard_never_run_dry_on_map_a():
+    """Agents that move at random among the guarded moves still reach the station in time
+    (wind, drain noise and traffic as in the paper), where unguarded ones run dry."""
+    spec = load_map("A")
+    failures = {}
+    for guard in (False, True):
+        cfg = make_config("A", max_agents=3, init_battery=(0.15, 0.4), return_guard=guard)
+        state = reset_state(spec, cfg, 3, n_envs=8, seed=1)
+        rng = np.random.default_rng(1)
+        failed = swaps = 0
+        for _ in range(1500):
+            info = step(spec, cfg, state, random_valid_moves(action_mask(spec, state, cfg), rng))
+            failed += int(info.battery_failed.sum())
+            swaps += int(info.swap_started.sum())
+        failures[guard] = failed
+        if guard:
+            assert swaps >= 24                                         # everyone swapped at least once
+    assert failures[True] == 0 and failures[False] > 0

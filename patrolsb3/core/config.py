@@ -65,6 +65,14 @@ class EnvConfig:
     a low battery toward the station (``core/reward.py``: ``home_potential``). 0, the
     paper's reward, by default."""
 
+    return_guard: bool = False
+    """OURS: a shield on the learned policy's moves. Once an agent's battery is at or below the
+    heuristics' recharge threshold for its cell (``core/masks.py``: ``return_threshold``), its
+    move mask keeps only the moves that bring it closer to a station (off a station and back
+    when the wind pushed it there), so it reaches the station with about ``b_l`` to spare and
+    the policy learns the patrol only. The simulator's own rule is unchanged; off (the paper's
+    agents, which learn the recharge) by default."""
+
     local_idleness: bool = False
     """OURS: append to the actor's vector the normalised idleness of the cell each move leads
     to (5 values, see ``core/observe.py``), so that "go where it is most idle" is learnable from

@@ -18,6 +18,7 @@ a station) are numbered ``0 .. V-1`` in the same row-major order.
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections import deque
 from pathlib import Path
 
@@ -90,6 +91,14 @@ class MapSpec:
     def station(self) -> int:
         """Cell index of the first charging station."""
         return int(self.stations[0])
+
+    @functools.cached_property
+    def steps_home(self) -> np.ndarray:
+        """(H*W,) int32 shortest-path steps from each free cell to its nearest station (0 on a
+        station and on obstacles)."""
+        steps = np.zeros(self.kinds.size, dtype=np.int32)
+        steps[self.free_cells] = self.nearest_station(self.free_cells)[0]
+        return steps
 
     def cell_distance(self, a, b) -> np.ndarray:
         """Shortest-path length between cell indices ``a`` and ``b`` (broadcasting arrays)."""

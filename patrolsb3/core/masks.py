@@ -7,6 +7,9 @@ import numpy as np
 from .maps import STATION, STAY, MapSpec
 from .state import State
 
+WAIT_ALLOWANCE = 1.25
+"""Extra factor on the trip home for steps spent waiting or yielding in traffic."""
+
 
 def station_cells(spec: MapSpec) -> np.ndarray:
     """(H*W,) bool, True on charging stations (cells any number of agents may share)."""
@@ -33,12 +36,73 @@ def _blocked(spec: MapSpec, state: State, target: np.ndarray) -> np.ndarray:
     return (others > 0) & ~station_cells(spec)[target]
 
 
-def action_mask(spec: MapSpec, state: State) -> np.ndarray:
+def return_threshold(spec: MapSpec, cfg) -> np.ndarray:
+    """Battery at or below which an agent on each cell must head for the station: the
+    heuristics' recharge rule (SPEC.md section 6), so that it arrives with about ``b_l`` left.
+
+        threshold(cell) = steps_home(cell) * drain_high * push_factor_margin + b_l
+        push_factor_margin = (1 + p_dyn_max (push_drain_factor - 1))   # pushed steps drain more
+                             * (1 + 2 p_dyn_max)                         # a push costs ~2 steps
+                             * WAIT_ALLOWANCE                            # waiting / yielding
+
+    Args:
+        spec: the map.
+        cfg: environment parameters (drain, pushes, b_l).
+
+    Returns:
+        (H*W,) float64 battery units.
+    """
+    push_factor_margin = ((1 + cfg.p_dyn_max * (cfg.push_drain_factor - 1))
+                          * (1 + 2 * cfg.p_dyn_max) * WAIT_ALLOWANCE)
+    return spec.steps_home * cfg.drain[1] * push_factor_margin + cfg.b_low
+
+
+def return_guard(spec: MapSpec, cfg, state: State, mask: np.ndarray) -> np.ndarray:
+    """The shield ``env.return_guard`` puts on a learned policy's moves (OURS, not the paper's).
+
+    An active agent whose battery is at or below :func:`return_threshold` for its cell keeps
+    only the valid moves that bring it one step closer to a station; on a station (where the
+    wind pushed it: a pushed arrival starts no swap) only the moves off it, so that it comes
+    back on purpose at the next step. When no such move is valid (another agent is in the
+    way) its mask is left as it was, so it may wait or step aside.
+
+    Args:
+        spec: the map.
+        cfg: environment parameters.
+        state: batched state.
+        mask: (E, A, 5) bool valid moves (:func:`action_mask`).
+
+    Returns:
+        (E, A, 5) bool, a subset of ``mask``.
+    """
+    pos = state.pos                                                            # (E, A)
+    due = state.active & (state.battery <= return_threshold(spec, cfg)[pos])   # (E, A)
+    if not due.any():
+        return mask
+    here = spec.steps_home[pos]                                                # (E, A)
+    there = spec.steps_home[spec.neighbour[pos]]                               # (E, A, 5)
+    toward = mask & (there < here[..., None])                                  # (E, A, 5)
+    leave = mask.copy()
+    leave[..., STAY] = False
+    shielded = np.where((here == 0)[..., None], leave, toward)                 # (E, A, 5)
+    use = due & shielded.any(axis=-1)                                          # (E, A)
+    out = mask.copy()
+    out[use] = shielded[use]
+    return out
+
+
+def action_mask(spec: MapSpec, state: State, cfg=None) -> np.ndarray:
     """Valid moves of every slot.
 
     A move is valid when it stays in the grid, does not enter an obstacle and does not enter
     a cell occupied by another active agent (stations excepted). ``Stay`` is always valid;
-    inactive slots may only stay.
+    inactive slots may only stay. With ``cfg.return_guard`` the learned policy's shield
+    (:func:`return_guard`) narrows the mask further; the simulator checks moves without it.
+
+    Args:
+        spec: the map.
+        state: batched state.
+        cfg: environment parameters; None (or ``return_guard`` off) for the plain rule.
 
     Returns:
         (E, A, 5) bool in action order Up, Down, Left, Right, Stay.
@@ -48,6 +112,8 @@ def action_mask(spec: MapSpec, state: State) -> np.ndarray:
     mask = spec.move_ok[pos] & ~_blocked(spec, state, target)
     mask[..., STAY] = True
     mask[~state.active] = np.array([False, False, False, False, True])
+    if cfg is not None and cfg.return_guard:
+        mask = return_guard(spec, cfg, state, mask)
     return mask
 
 
@@ -86,7 +152,7 @@ def composite_action_mask(spec: MapSpec, cfg, state: State, message_phase: bool)
     Returns:
         message (E, A, n_symbols) bool and move (E, A, 5) bool.
     """
-    move = action_mask(spec, state)                                        # (E, A, 5)
+    move = action_mask(spec, state, cfg)                                   # (E, A, 5)
     E, A = state.pos.shape
     message = np.zeros((E, A, cfg.n_symbols), dtype=bool)
     chooses_message = cfg.comm != "none" and (message_phase or cfg.message_timing == "delayed")

@@ -116,7 +116,7 @@ def actor_observation(spec: MapSpec, cfg: EnvConfig, state: State, phase: int = 
     grid[:, :, 1] = chan1[:, None, :]
 
     if mask is None:
-        mask = action_mask(spec, state)
+        mask = action_mask(spec, state, cfg)
     vector = np.empty((E, A, vector_size(cfg)), dtype=np.float32)
     vector[..., 0] = state.battery / cfg.b_max
     vector[..., 1:6] = mask

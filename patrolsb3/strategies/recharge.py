@@ -1,17 +1,12 @@
 """The recharge planner every heuristic shares (SPEC.md section 6).
 
-Rule: an active agent heads for its nearest charging station as soon as
+Rule: an active agent heads for its nearest charging station as soon as its battery is at or
+below :func:`patrolsb3.core.masks.return_threshold` for its cell,
 
     battery <= steps_home(cell) * drain_high * push_factor_margin + b_l
 
-where ``steps_home`` is the shortest-path length to the nearest station, ``drain_high`` the
-largest drain of one step (``cfg.drain[1]``) and
-
-    push_factor_margin = (1 + p_dyn_max (push_drain_factor - 1))   # pushed steps drain more
-                         * (1 + 2 p_dyn_max)                         # a push costs ~2 steps
-                         * WAIT_ALLOWANCE                            # waiting / yielding
-
-so that it arrives with about ``b_l`` (20 % of b_max) to spare. The decision is latched: the
+(the one place of that rule; the learned policies' optional shield ``env.return_guard`` uses
+it too), so that it arrives with about ``b_l`` (20 % of b_max) to spare. The decision is latched: the
 agent keeps heading home (shortest path, valid moves only) until its swap starts, and a new
 agent appears with a full battery. An agent that the wind pushed onto the station (a pushed
 arrival starts no swap) steps off and back on.
@@ -35,12 +30,10 @@ import numpy as np
 
 from ..core.config import EnvConfig
 from ..core.maps import STAY, MapSpec
-from ..core.masks import station_cells
+from ..core.masks import return_threshold, station_cells
 from ..core.state import ACTIVE, State
 from .navigation import Navigator
 
-WAIT_ALLOWANCE = 1.25
-"""Extra factor on the trip home for steps spent waiting or yielding in traffic."""
 PATROL_PATIENCE = 3
 """Blocked steps a patrolling agent tolerates before moving aside."""
 HOME_PATIENCE = 8
@@ -64,12 +57,8 @@ class RechargePlanner:
         n_cells = spec.kinds.size
         self.station_of_cell = np.full(n_cells, spec.station, dtype=np.int64)   # (H*W,) nearest station
         self.station_of_cell[spec.free_cells] = spec.stations[np.argmin(to_station, axis=1)]
-        self.steps_home = np.zeros(n_cells)                                     # (H*W,)
-        self.steps_home[spec.free_cells] = to_station.min(axis=1)
-        self.push_factor_margin = ((1 + cfg.p_dyn_max * (cfg.push_drain_factor - 1))
-                                   * (1 + 2 * cfg.p_dyn_max) * WAIT_ALLOWANCE)
-        self.threshold = (self.steps_home * cfg.drain[1] * self.push_factor_margin
-                          + cfg.b_low)                                          # (H*W,) battery units
+        self.steps_home = spec.steps_home                                       # (H*W,)
+        self.threshold = return_threshold(spec, cfg)                            # (H*W,) battery units
         self.is_station = station_cells(spec)                                   # (H*W,)
 
     def update(self, sim: State, returning: np.ndarray) -> np.ndarray:
