@@ -1,7 +1,7 @@
 """The CPU time a training run spent, measured by the run itself: ``<run>/cpu_time.csv``.
 
 One row when each rollout starts (the update of the rollout before it done) and one when the
-run stops, with its last checkpoint: the agent-steps reached and the CPU seconds of the
+run stops, with its last checkpoint, at most one per agent-step count: the agent-steps reached and the CPU seconds of the
 training process (every thread, ``time.process_time``) spent in ``learn()`` so far, counted
 across ``--resume`` calls. A resumed run first cuts the rows past the checkpoint it resumes
 from, so the file always describes the path that led to its checkpoints. A warm-started run
@@ -83,6 +83,8 @@ class CpuTimeCallback(BaseCallback):
         super().__init__(verbose)
         self.path = Path(run_dir) / CPU_TIME_FILE
         self.offset = float(offset_seconds)
+        rows = read_rows(run_dir)
+        self.last_timesteps = rows[-1][0] if rows else -1     # a resume starts at its checkpoint's row
         self.started = time.process_time()
 
     def _on_training_start(self) -> None:
@@ -95,7 +97,12 @@ class CpuTimeCallback(BaseCallback):
         self.record(self.num_timesteps)
 
     def record(self, timesteps: int) -> None:
-        """Append one row: ``timesteps`` and the CPU seconds spent so far."""
+        """Append one row: ``timesteps`` and the CPU seconds spent so far; none when a row
+        already holds these agent-steps (a resumed run's first rollout starts at its
+        checkpoint, whose row the run before it wrote)."""
+        if timesteps <= self.last_timesteps:
+            return
+        self.last_timesteps = int(timesteps)
         new = not self.path.exists()
         with self.path.open("a", newline="") as f:
             writer = csv.writer(f)
