@@ -224,3 +224,29 @@ def test_zoo_list_prints_budget_and_headline_figures(trained, capsys):
     text = headline(entry)
     assert "n=1: MAX 12 AVG 5 col 1.5 BF 0.00" in text
     assert "n=2: MAX/AVG/col n/a (a battery failure in every episode) BF 1.00" in text and "nan" not in text
+
+
+def test_a_model_trained_behind_the_return_guard_acts_behind_it(trained, tmp_path):
+    import shutil
+    from patrolsb3.core.masks import action_mask, return_threshold
+    shutil.copytree(trained["folder"], tmp_path / "zoo" / "ROOM" / "rl-msg")
+    path = tmp_path / "zoo" / "ROOM" / "rl-msg" / "config.yml"
+    config = yaml.safe_load(path.read_text())
+    config["env"]["return_guard"] = True
+    path.write_text(yaml.safe_dump(config))
+    guarded = zoo.load("ROOM", "rl-msg", zoo_dir=tmp_path / "zoo", spec=trained["map_file"])
+    plain = zoo.load("ROOM", "rl-msg", zoo_dir=trained["folder"].parent.parent, spec=trained["map_file"])
+    assert guarded.cfg.return_guard and not plain.cfg.return_guard
+    spec = load_map(trained["map_file"])
+    cfg = make_config(None, episode_steps=50)
+    sim = reset_state(spec, cfg, [4, 4], n_envs=2, seed=1)
+    sim.battery[:] = return_threshold(spec, guarded.cfg)[sim.pos]                # every agent due home
+    shield = action_mask(spec, sim, guarded.cfg)                                # (2, 5, 5)
+    assert (shield.sum(axis=-1)[sim.active] < action_mask(spec, sim).sum(axis=-1)[sim.active]).any()
+    outside = {}
+    for name, policy in (("guarded", guarded), ("plain", plain)):
+        policy.seed_sampling(0)
+        moves = np.stack([policy.predict(sim, deterministic=False)[0][..., 1] for _ in range(20)])  # (20, 2, 5)
+        chosen = np.take_along_axis(np.broadcast_to(shield, (20,) + shield.shape), moves[..., None], -1)[..., 0]
+        outside[name] = int((~chosen & sim.active).sum())
+    assert outside["guarded"] == 0 and outside["plain"] > 0
