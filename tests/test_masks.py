@@ -170,13 +170,25 @@ def test_return_guard_sends_a_pushed_arrival_off_the_station_and_back(middle_sta
     assert list(action_mask(spec, state, cfg)[0, 0]) == [False, False, True, True, False]
 
 
-def test_return_guard_leaves_a_blocked_agent_its_plain_mask(line_map):
+def test_a_blocked_due_agent_waits_and_has_right_of_way(line_map):
     spec = line_map                                                    # "S....."
-    cfg = deterministic_config(max_agents=2, return_guard=True)
-    state = place(spec, cfg, [(0, 2), (0, 1)], battery=[_due(cfg, spec, 0, 2), cfg.b_max])
-    plain = action_mask(spec, state)[0, 0]
-    assert list(plain) == [False, False, False, True, True]            # Left is occupied
-    assert (action_mask(spec, state, cfg)[0, 0] == plain).all()
+    cfg = deterministic_config(max_agents=3, return_guard=True)
+    state = place(spec, cfg, [(0, 2), (0, 1), (0, 5)], battery=[_due(cfg, spec, 0, 2), cfg.b_max, cfg.b_max])
+    assert list(action_mask(spec, state)[0, 0]) == [False, False, False, True, True]   # Left held
+    mask = action_mask(spec, state, cfg)[0]
+    assert list(mask[0]) == [False, False, False, False, True]         # waits
+    assert list(mask[1]) == [False, False, True, False, False]         # gives way (onto S)
+    assert list(mask[2]) == [False, False, True, False, True]          # not in the way: free
+
+
+def test_an_agent_in_the_way_with_nowhere_to_go_may_stay(line_map):
+    spec = line_map                                                    # "S....."
+    cfg = deterministic_config(max_agents=3, return_guard=True)
+    state = place(spec, cfg, [(0, 3), (0, 2), (0, 1)], battery=[_due(cfg, spec, 0, 3), cfg.b_max, cfg.b_max])
+    mask = action_mask(spec, state, cfg)[0]
+    assert list(mask[0]) == ONLY_STAY                                  # waits behind slot 1
+    assert list(mask[1]) == ONLY_STAY                                  # in the way, boxed in
+    assert list(mask[2]) == [False, False, True, False, True]          # not in the way: free
 
 
 def test_return_guard_reaches_the_composite_mask_and_the_observation(middle_station_map):

@@ -30,6 +30,16 @@
 # this run's cpu_time.csv up to the checkpoint (B 0.34, D 0.20); v4's stage-2 files removed
 # from the entries (the v4 entries are in the git history), the sampled evaluation and the
 # comparison as for A v5 below.
+# A, B and D rl-msg v7 (2026-12-01, evening): stage g of zoo/train_stages.sh (long episodes
+# behind the return guard env.return_guard=true), three runs side by side, 6,000 s each:
+#   STAGE1_OUT=runs/v5_stage1 ZOO_RUNS="B:rl-msg D:rl-msg" zoo/train_stages.sh g 6000
+#   STAGEG_FROM="zoo/{map}/{variant}" ZOO_RUNS="A:rl-msg" zoo/train_stages.sh g 6000   # from A's v5
+# the newest five checkpoints of each validated with
+#   patrolsb3 zoo validate runs/stageg/<map>/rl-msg/MaskableRecurrentPPO_seed0 --last 5
+# and the best exported with --episodes 10 --steps 14400 --seed 0 (A: CPU hours measured along
+# the chain; B and D: --cpu-hours = stage 1 (ps, 0.26) + this run's cpu_time.csv up to the
+# checkpoint), B and D's stage-1 curve and command kept beside; the sampled evaluation and the
+# comparison as for A v5 below.
 # A v5 (rl-msg, rl-intention; rl-no-msg keeps v4): stage 4 from the v4 entries,
 #   ZOO_RUNS="A:rl-msg" TIMESTEPS=1228800 STAGE4_OUT=runs/mix zoo/train_stages.sh 4 5400
 #   ZOO_RUNS="A:rl-no-msg A:rl-intention" STAGE4_OUT=runs/mix zoo/train_stages.sh 4 3000

@@ -63,8 +63,10 @@ def return_guard(spec: MapSpec, cfg, state: State, mask: np.ndarray) -> np.ndarr
     An active agent whose battery is at or below :func:`return_threshold` for its cell keeps
     only the valid moves that bring it one step closer to a station; on a station (where the
     wind pushed it: a pushed arrival starts no swap) only the moves off it, so that it comes
-    back on purpose at the next step. When no such move is valid (another agent is in the
-    way) its mask is left as it was, so it may wait or step aside.
+    back on purpose at the next step. When other agents hold every cell one step closer, it
+    waits (``Stay`` only), and it has right of way, as in the heuristics' planner: an agent
+    that is not due and stands on such a cell may not stay (unless it has no other valid
+    move), so the way clears at the next step.
 
     Args:
         spec: the map.
@@ -80,14 +82,22 @@ def return_guard(spec: MapSpec, cfg, state: State, mask: np.ndarray) -> np.ndarr
     if not due.any():
         return mask
     here = spec.steps_home[pos]                                                # (E, A)
-    there = spec.steps_home[spec.neighbour[pos]]                               # (E, A, 5)
-    toward = mask & (there < here[..., None])                                  # (E, A, 5)
-    leave = mask.copy()
-    leave[..., STAY] = False
-    shielded = np.where((here == 0)[..., None], leave, toward)                 # (E, A, 5)
-    use = due & shielded.any(axis=-1)                                          # (E, A)
+    target = spec.neighbour[pos]                                               # (E, A, 5)
+    closer = spec.move_ok[pos] & (spec.steps_home[target] < here[..., None])   # (E, A, 5) ignoring agents
+    toward = mask & closer                                                     # (E, A, 5)
+    on_station = here == 0                                                     # (E, A)
+    blocked = due & ~on_station & ~toward.any(axis=-1)                         # (E, A) way home held
     out = mask.copy()
-    out[use] = shielded[use]
+    go_home = due & ~on_station & ~blocked
+    out[go_home] = toward[go_home]
+    out[blocked] = np.array([False, False, False, False, True])
+    leave = due & on_station & mask[..., :STAY].any(axis=-1)
+    out[leave, STAY] = False
+    # right of way: agents standing on a cell a blocked due agent needs must move on
+    needed = np.where(blocked[..., None] & closer, target, -1)                 # (E, A, 5) cells, -1 none
+    holds = (pos[:, :, None, None] == needed[:, None, :, :]).any(axis=(2, 3))  # (E, A) on a needed cell
+    give_way = holds & state.active & ~due & mask[..., :STAY].any(axis=-1)
+    out[give_way, STAY] = False
     return out
 
 
