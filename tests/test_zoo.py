@@ -214,7 +214,7 @@ def test_zoo_list_prints_budget_and_headline_figures(trained, capsys):
     from patrolsb3.commands.zoo import headline
     assert cli.main(["zoo", "list", "--zoo-dir", str(trained["root"] / "zoo")]) == 0
     out = capsys.readouterr().out
-    assert "room/rl-msg" in out and "0.001 CPU h" in out
+    assert "room/rl-msg" in out and "0.001 CPU h" in out and "return guard" not in out
     ok = {"max_idleness": {"mean": 12.4}, "avg_idleness": {"mean": 5.2}, "collisions": {"mean": 1.54},
           "battery_failure_rate": {"mean": 0.0}}
     failed = {**ok, "max_idleness": {"mean": float("nan")}, "avg_idleness": {"mean": float("nan")},
@@ -226,7 +226,7 @@ def test_zoo_list_prints_budget_and_headline_figures(trained, capsys):
     assert "n=2: MAX/AVG/col n/a (a battery failure in every episode) BF 1.00" in text and "nan" not in text
 
 
-def test_a_model_trained_behind_the_return_guard_acts_behind_it(trained, tmp_path):
+def test_a_model_trained_behind_the_return_guard_acts_behind_it(trained, tmp_path, capsys):
     import shutil
     from patrolsb3.core.masks import action_mask, return_threshold
     shutil.copytree(trained["folder"], tmp_path / "zoo" / "ROOM" / "rl-msg")
@@ -250,3 +250,7 @@ def test_a_model_trained_behind_the_return_guard_acts_behind_it(trained, tmp_pat
         chosen = np.take_along_axis(np.broadcast_to(shield, (20,) + shield.shape), moves[..., None], -1)[..., 0]
         outside[name] = int((~chosen & sim.active).sum())
     assert outside["guarded"] == 0 and outside["plain"] > 0
+    from patrolsb3 import cli
+    assert cli.main(["zoo", "list", "--zoo-dir", str(tmp_path / "zoo")]) == 0
+    listed = capsys.readouterr().out
+    assert "room/rl-msg" in listed and "behind the return guard" in listed

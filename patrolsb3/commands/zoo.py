@@ -69,7 +69,9 @@ def run(args):
         budget = c.get("budget", {})
         print(f"{c.get('map', '?')}/{c.get('variant', '?')}  algo {c.get('algo', '?')}  "
               f"env {c.get('env_version', '?')}  trained {c.get('date', '?')}  "
-              f"{budget.get('timesteps', '?')} steps, {budget.get('cpu_hours', '?')} CPU h")
+              f"{budget.get('timesteps', '?')} steps, {budget.get('cpu_hours', '?')} CPU h"
+              + ("  behind the return guard (env.return_guard, ours)"
+                 if (c.get("env") or {}).get("return_guard") else ""))
         print(f"    {headline(e)}")
     return 0
 
