@@ -31,11 +31,15 @@
 # from the entries (the v4 entries are in the git history), the sampled evaluation and the
 # comparison as for A v5 below.
 # A, B and D rl-msg v7 (2026-12-01, evening): stage g of zoo/train_stages.sh (long episodes
-# behind the return guard env.return_guard=true), three runs side by side, 6,000 s each:
+# behind the return guard env.return_guard=true), three runs side by side, 6,000 s each (they
+# stopped at their 4 M step budget), then resumed to 6.5 M (stopped once on the way to take
+# the guard's final rule, zoo/README.md):
 #   STAGE1_OUT=runs/v5_stage1 ZOO_RUNS="B:rl-msg D:rl-msg" zoo/train_stages.sh g 6000
 #   STAGEG_FROM="zoo/{map}/{variant}" ZOO_RUNS="A:rl-msg" zoo/train_stages.sh g 6000   # from A's v5
-# the newest five checkpoints of each validated with
-#   patrolsb3 zoo validate runs/stageg/<map>/rl-msg/MaskableRecurrentPPO_seed0 --last 5
+#   STAGE1_OUT=runs/v5_stage1 ZOO_RUNS="A:rl-msg B:rl-msg D:rl-msg" TIMESTEPS=6500000 \
+#     zoo/train_stages.sh g 2640 --resume            # and again with 1900 s
+# the newest six checkpoints of each validated with
+#   patrolsb3 zoo validate runs/stageg/<map>/rl-msg/MaskableRecurrentPPO_seed0 --last 6
 # and the best exported with --episodes 10 --steps 14400 --seed 0 (A: CPU hours measured along
 # the chain; B and D: --cpu-hours = stage 1 (ps, 0.26) + this run's cpu_time.csv up to the
 # checkpoint), B and D's stage-1 curve and command kept beside; the sampled evaluation and the
