@@ -70,8 +70,9 @@ class EnvConfig:
     heuristics' recharge threshold for its cell (``core/masks.py``: ``return_threshold``), its
     move mask keeps only the moves that bring it closer to a station (off a station and back
     when the wind pushed it there; it waits, with right of way, when its way is held), so it
-    reaches the station with about ``b_l`` to spare and the policy learns the patrol only. The simulator's own rule is unchanged; off (the paper's
-    agents, which learn the recharge) by default."""
+    reaches the station with about ``b_l`` to spare and the policy learns the patrol only.
+    The simulator's own rule is unchanged; off (the paper's agents, which learn the recharge)
+    by default."""
 
     local_idleness: bool = False
     """OURS: append to the actor's vector the normalised idleness of the cell each move leads

@@ -91,12 +91,12 @@ def return_guard(spec: MapSpec, cfg, state: State, mask: np.ndarray) -> np.ndarr
     go_home = due & ~on_station & ~blocked
     out[go_home] = toward[go_home]
     out[blocked] = np.array([False, False, False, False, True])
-    leave = due & on_station & mask[..., :STAY].any(axis=-1)
-    out[leave, STAY] = False
+    can_move = mask[..., :STAY].any(axis=-1)                                   # (E, A) a move but Stay
+    out[due & on_station & can_move, STAY] = False
     # right of way: agents standing on a cell a blocked due agent needs must move on
     needed = np.where(blocked[..., None] & closer, target, -1)                 # (E, A, 5) cells, -1 none
     holds = (pos[:, :, None, None] == needed[:, None, :, :]).any(axis=(2, 3))  # (E, A) on a needed cell
-    give_way = holds & state.active & ~due & mask[..., :STAY].any(axis=-1)
+    give_way = holds & state.active & ~due & can_move
     out[give_way, STAY] = False
     return out
 
