@@ -8,8 +8,8 @@ below :func:`patrolsb3.core.masks.return_threshold` for its cell,
 (the one place of that rule; the learned policies' optional shield ``env.return_guard`` uses
 it too), so that it arrives with about ``b_l`` (20 % of b_max) to spare. The decision is
 latched: the agent keeps heading home (shortest path, valid moves only) until its swap
-starts, and a new agent appears with a full battery. An agent that the wind pushed onto the station (a pushed
-arrival starts no swap) steps off and back on.
+starts, and a new agent appears with a full battery. An agent that the wind pushed onto the
+station (a pushed arrival starts no swap) steps off and back on.
 
 Deadlocks: any number of agents may share a station, so arrivals never wait for each other
 there; agents leave a station only while no agent heading home is within
