@@ -44,6 +44,17 @@
 # the chain; B and D: --cpu-hours = stage 1 (ps, 0.26) + this run's cpu_time.csv up to the
 # checkpoint), B and D's stage-1 curve and command kept beside; the sampled evaluation and the
 # comparison as for A v5 below.
+# A/rl-no-msg, A/rl-intention and C/rl-msg v7 (2026-12-01, night): stage g too, three runs
+# side by side (stopped near 0.6 M when the machine went, resumed from the 500 k checkpoints):
+#   STAGEG_FROM="zoo/{map}/{variant}" ZOO_RUNS="A:rl-no-msg A:rl-intention" TIMESTEPS=6500000 \
+#     zoo/train_stages.sh g 7200                     # then again with 6800 --resume
+#   STAGE1_OUT=runs/v5_stage1 ZOO_RUNS="C:rl-msg" TIMESTEPS=6500000 zoo/train_stages.sh g 7200
+#                                                    # then again with 6800 --resume
+# (each reached its 6.5 M step budget), validated and exported as A, B and D's v7 (the best:
+# A/rl-no-msg 5,500,000, A/rl-intention 6,500,640, C 6,000,000; C with --cpu-hours = stage 1
+# (ps, 0.26) + this run's cpu_time.csv up to the checkpoint, 0.96), A's earlier command.txt
+# and curve.csv renamed *_stage3 (rl-no-msg) and *_stage4 (rl-intention), C's v4 stage-2/3
+# files removed (git history); the sampled evaluation and the comparison as for A v5 below.
 # A v5 (rl-msg, rl-intention; rl-no-msg keeps v4): stage 4 from the v4 entries,
 #   ZOO_RUNS="A:rl-msg" TIMESTEPS=1228800 STAGE4_OUT=runs/mix zoo/train_stages.sh 4 5400
 #   ZOO_RUNS="A:rl-no-msg A:rl-intention" STAGE4_OUT=runs/mix zoo/train_stages.sh 4 3000
