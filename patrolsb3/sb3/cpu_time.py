@@ -3,11 +3,10 @@
 One row when each rollout starts (the update of the rollout before it done) and one when the
 run stops, with its last checkpoint, at most one per agent-step count: the agent-steps reached
 and the CPU seconds of the training process (every thread, ``time.process_time``) spent in
-``learn()`` so far, counted
-across ``--resume`` calls. A resumed run first cuts the rows past the checkpoint it resumes
-from, so the file always describes the path that led to its checkpoints. A warm-started run
-(``--init-from``) records the CPU hours of its source in ``config.yml``
-(``init_from.cpu_hours``), so :func:`cpu_hours_of` adds up a chain of stages,
+``learn()`` so far, counted across ``--resume`` calls. A resumed run first cuts the rows past
+the checkpoint it resumes from, so the file always describes the path that led to its
+checkpoints. A warm-started run (``--init-from``) records the CPU hours of its source in
+``config.yml`` (``init_from.cpu_hours``), so :func:`cpu_hours_of` adds up a chain of stages,
 which is what ``patrolsb3 zoo export`` records as the entry's budget.
 """
 from __future__ import annotations
