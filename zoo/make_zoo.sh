@@ -55,6 +55,16 @@
 # (ps, 0.26) + this run's cpu_time.csv up to the checkpoint, 0.96), A's earlier command.txt
 # and curve.csv renamed *_stage3 (rl-no-msg) and *_stage4 (rl-intention), C's v4 stage-2/3
 # files removed (git history); the sampled evaluation and the comparison as for A v5 below.
+# B, C and D rl-no-msg v7 (2026-12-02): stage 1 and stage g as their rl-msg, three runs side
+# by side (stage g stopped by time at 1.93 M and 6.30 M, resumed with --resume each time):
+#   STAGE1_OUT=runs/v5_stage1 STAGE1_RUNS="B:rl-no-msg C:rl-no-msg D:rl-no-msg" \
+#     TIMESTEPS=1500000 zoo/train_stages.sh 1 2700
+#   STAGE1_OUT=runs/v5_stage1 ZOO_RUNS="B:rl-no-msg C:rl-no-msg D:rl-no-msg" TIMESTEPS=6500000 \
+#     zoo/train_stages.sh g 2100                     # then 4500 --resume, then 900 --resume
+# validated and exported as A, B and D's v7 (the best: B 6,502,400, C 6,175,120, D 5,675,120;
+# CPU hours measured along the chain, stage 1 included), the stage-1 curve and command copied
+# beside as curve_stage1.csv / command_stage1.txt; the sampled evaluation and the comparison
+# as for A v5 below.
 # A v5 (rl-msg, rl-intention; rl-no-msg keeps v4): stage 4 from the v4 entries,
 #   ZOO_RUNS="A:rl-msg" TIMESTEPS=1228800 STAGE4_OUT=runs/mix zoo/train_stages.sh 4 5400
 #   ZOO_RUNS="A:rl-no-msg A:rl-intention" STAGE4_OUT=runs/mix zoo/train_stages.sh 4 3000
