@@ -65,6 +65,14 @@
 # CPU hours measured along the chain, stage 1 included), the stage-1 curve and command copied
 # beside as curve_stage1.csv / command_stage1.txt; the sampled evaluation and the comparison
 # as for A v5 below.
+# B, C and D rl-intention v7 (2026-12-02): the same, three runs side by side (stage g stopped
+# by time at about 2.5 M, resumed with --resume):
+#   STAGE1_OUT=runs/v5_stage1 STAGE1_RUNS="B:rl-intention C:rl-intention D:rl-intention" \
+#     TIMESTEPS=1500000 zoo/train_stages.sh 1 3000
+#   STAGE1_OUT=runs/v5_stage1 ZOO_RUNS="B:rl-intention C:rl-intention D:rl-intention" \
+#     TIMESTEPS=6500000 zoo/train_stages.sh g 2880   # then 4800 --resume
+# validated and exported as above (the best: B 6,502,360, C 5,498,840, D 5,990,680), the
+# stage-1 curve and command beside; the sampled evaluation and the comparison as for A v5 below.
 # A v5 (rl-msg, rl-intention; rl-no-msg keeps v4): stage 4 from the v4 entries,
 #   ZOO_RUNS="A:rl-msg" TIMESTEPS=1228800 STAGE4_OUT=runs/mix zoo/train_stages.sh 4 5400
 #   ZOO_RUNS="A:rl-no-msg A:rl-intention" STAGE4_OUT=runs/mix zoo/train_stages.sh 4 3000
