@@ -8,14 +8,11 @@ from gymnasium import spaces
 from pettingzoo import ParallelEnv
 from pettingzoo.utils.conversions import parallel_to_aec
 
+from .core import protocol
 from .core.config import ENV_VERSION, EnvConfig, make_config
 from .core.maps import STAY, load_map
-from .core.masks import composite_action_mask
-from .core.observe import actor_observation, critic_state, vector_size
+from .core.observe import vector_size
 from .core.state import STATUS_NAMES, reset_state
-from .core.step import step as core_step
-
-MESSAGE_PHASE, MOVE_PHASE = 0, 1
 
 
 class PatrolParallelEnv(ParallelEnv):
@@ -78,8 +75,8 @@ class PatrolParallelEnv(ParallelEnv):
         self.agents = []
         self._seed = seed
         self.core_state = None
-        self.phase = MOVE_PHASE
-        self._two_phase = self.cfg.two_phase
+        self.phase = protocol.first_phase(self.cfg)
+        self._decision = None   # protocol.Decision of the current phase
         H, W = self.spec_map.shape
         A = self.cfg.max_agents
         self._obs_space = spaces.Dict({
@@ -101,19 +98,14 @@ class PatrolParallelEnv(ParallelEnv):
             TypeError: an unknown EnvConfig field.
         """
         cfg = make_config(None, **{**self.cfg.to_dict(), **overrides})
-        shape = (lambda c: (c.max_agents, c.n_symbols, c.two_phase, vector_size(c), c.comm))
-        if shape(cfg) != shape(self.cfg):
+        if protocol.protocol_signature(cfg) != protocol.protocol_signature(self.cfg):
             changed = [k for k in overrides if getattr(cfg, k) != getattr(self.cfg, k)]
             raise ValueError(f"reconfigure: {', '.join(changed)} would change the spaces or phases "
                              f"of the env; only settings that keep them can differ per episode")
         self.cfg = cfg
 
     def _check_team(self, n_agents):
-        if not 1 <= int(n_agents) <= self.cfg.max_agents:
-            raise ValueError(f"n_agents={n_agents} must be between 1 and max_agents={self.cfg.max_agents}")
-        if int(n_agents) > self.spec_map.n_vertices:
-            raise ValueError(f"n_agents={n_agents} is larger than the {self.spec_map.n_vertices} "
-                             f"vertices of map {self.spec_map.name}")
+        protocol.check_team(self.spec_map, self.cfg, n_agents)
 
     @functools.lru_cache(maxsize=None)
     def observation_space(self, agent):
@@ -133,45 +125,26 @@ class PatrolParallelEnv(ParallelEnv):
             self.n_agents = int(options["n_agents"])
         self.core_state = reset_state(self.spec_map, self.cfg, self.n_agents, n_envs=1, seed=seed)
         self.agents = list(self.possible_agents)
-        self.phase = MESSAGE_PHASE if self._two_phase else MOVE_PHASE
         self._last_info = None
         self.episode_collisions = 0
+        self._decide(protocol.first_phase(self.cfg))
         return self._observations(), self._infos(None)
 
     def step(self, actions):
         """Apply one (message, move) action per agent; see the class docstring for phases."""
-        A = self.cfg.max_agents
-        act = np.zeros((A, 2), dtype=np.int64)
-        act[:, 1] = STAY
+        act = np.zeros((1, self.cfg.max_agents, 2), dtype=np.int64)             # (1, A, 2)
+        act[..., 1] = STAY
         for i, name in enumerate(self.possible_agents):
             if name in actions and actions[name] is not None:
-                act[i] = np.asarray(actions[name], dtype=np.int64).reshape(2)
-        active = self.core_state.active[0]
-        comm = self.cfg.comm
-        if self.phase == MESSAGE_PHASE:
-            self._check_message_phase(act, active)
-            symbols = self._symbols(act[:, 0], active)
-            self.core_state.messages = symbols[None]
-            self.phase = MOVE_PHASE
+                act[0, i] = np.asarray(actions[name], dtype=np.int64).reshape(2)
+        phase = self.phase
+        act = protocol.check_actions(self.cfg, phase, act, self._decision.masks)
+        info = protocol.apply_actions(self.spec_map, self.cfg, self.core_state, phase, act)
+        self._decide(protocol.next_phase(self.cfg, phase))
+        if info is None:  # a message phase: symbols shown, the simulator did not step
             zeros = {a: 0.0 for a in self.agents}
             falses = {a: False for a in self.agents}
             return self._observations(), zeros, falses, dict(falses), self._infos(None)
-        if self._two_phase or comm == "none":
-            bad = active & (act[:, 0] != 0)
-            if bad.any() and self.cfg.invalid_action == "raise":
-                raise ValueError(f"{self.possible_agents[int(np.argmax(bad))]} sent message index "
-                                 f"{act[int(np.argmax(bad)), 0]} where only 0 is legal (its mask "
-                                 f"allows no message in this phase)")
-            act[:, 0] = 0
-            info = core_step(self.spec_map, self.cfg, self.core_state, act[None, :, 1])
-        else:  # delayed messages: chosen now, shown at the next step
-            symbols = self._symbols(act[:, 0], active)
-            info = core_step(self.spec_map, self.cfg, self.core_state, act[None, :, 1],
-                             messages=np.zeros((1, A), dtype=np.int64))
-            self.core_state.messages = np.where(self.core_state.active, symbols[None], 0)
-        if self._two_phase:
-            self.phase = MESSAGE_PHASE
-            self.core_state.messages = np.zeros_like(self.core_state.messages)
         self.episode_collisions += int(info.collisions[0])
         self._last_info = info
         rewards = {a: float(info.reward[0, i]) for i, a in enumerate(self.agents)}
@@ -184,48 +157,37 @@ class PatrolParallelEnv(ParallelEnv):
             self.agents = []
         return obs, rewards, terminations, truncations, infos
 
-    def _symbols(self, message_idx, active):
-        """Symbols (1..n_symbols) shown by active slots, 0 for the others."""
-        return np.where(active, message_idx + 1, 0).astype(np.int64)
-
-    def _check_message_phase(self, act, active):
-        """Check (or, with invalid_action='stay', repair in place) message-phase actions."""
-        masks = self._masks()
-        for i, name in enumerate(self.possible_agents):
-            m_ok = 0 <= act[i, 0] < self.cfg.n_symbols and masks[i][0][act[i, 0]]
-            if m_ok and act[i, 1] == STAY:
-                continue
-            if self.cfg.invalid_action == "raise":
-                raise ValueError(f"{name}: action {tuple(int(v) for v in act[i])} is not legal in the "
-                                 f"message phase (message must be allowed by its mask, move must be Stay)")
-            act[i, 1] = STAY
-            if not m_ok:
-                act[i, 0] = int(np.argmax(masks[i][0]))
+    def _decide(self, phase: int) -> None:
+        """Enter ``phase``: observations and masks of the current state, computed once."""
+        self.phase = phase
+        self._decision = protocol.decide(self.spec_map, self.cfg, self.core_state, phase)
 
     def _masks(self):
         """Per slot (message_mask (n_symbols,), move_mask (5,)) int8, for the current phase."""
-        message, move = composite_action_mask(self.spec_map, self.cfg, self.core_state,
-                                              message_phase=self.phase == MESSAGE_PHASE)
-        return [(message[0, i].astype(np.int8), move[0, i].astype(np.int8))
-                for i in range(self.cfg.max_agents)]
+        masks = self._decision.masks[0].astype(np.int8)                          # (A, n_symbols + 5)
+        n = self.cfg.n_symbols
+        return [(masks[i, :n], masks[i, n:]) for i in range(self.cfg.max_agents)]
 
     def _observations(self):
-        grid, vector = actor_observation(self.spec_map, self.cfg, self.core_state, phase=self.phase)
-        critic = critic_state(self.spec_map, self.cfg, self.core_state)[0]
-        return {name: {"grid": grid[0, i], "vector": vector[0, i], "critic": critic}
+        d = self._decision
+        return {name: {"grid": d.grid[0, i], "vector": d.vector[0, i], "critic": d.critic[0]}
                 for i, name in enumerate(self.possible_agents)}
 
     def _infos(self, info):
         masks = self._masks()
         s = self.core_state
+        phase = protocol.PHASE_NAMES[self.phase]
+        step_no = int(s.t[0])
+        battery = (s.battery[0] / self.cfg.b_max).tolist()
+        status = s.status[0].tolist()
         out = {}
         for i, name in enumerate(self.possible_agents):
             d = {
                 "action_mask": masks[i],
-                "phase": "message" if self.phase == MESSAGE_PHASE else "move",
-                "status": STATUS_NAMES[s.status[0, i]],
-                "battery": float(s.battery[0, i] / self.cfg.b_max),
-                "step": int(s.t[0]),
+                "phase": phase,
+                "status": STATUS_NAMES[status[i]],
+                "battery": battery[i],
+                "step": step_no,
             }
             if info is not None:
                 d.update({

@@ -18,10 +18,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from .core import protocol
 from .core.config import ENV_VERSION, EnvConfig, make_config
 from .core.maps import MapSpec, load_map
-from .core.masks import composite_action_mask
-from .core.observe import actor_observation, critic_state
 
 ZOO_DIR = Path(__file__).resolve().parent.parent / "zoo"
 VARIANT_NAMES = ("rl-msg", "rl-no-msg", "rl-intention")
@@ -29,19 +28,6 @@ VARIANT_NAMES = ("rl-msg", "rl-no-msg", "rl-intention")
 
 class ZooError(ValueError):
     """A zoo entry that is missing, incomplete or incompatible with this code."""
-
-
-def flat_observation(spec, cfg: EnvConfig, state, phase: int) -> np.ndarray:
-    """Observations in the training layout [grid (2*H*W), vector (vector_size(cfg)), critic (3*A)].
-
-    Returns:
-        (E * A, 2*H*W + vector_size(cfg) + 3*A) float32, row e * A + i = slot i of episode e.
-    """
-    grid, vector = actor_observation(spec, cfg, state, phase=phase)        # (E,A,2,H,W), (E,A,vector_size)
-    E, A = state.pos.shape
-    critic = np.broadcast_to(critic_state(spec, cfg, state)[:, None, :], (E, A, 3 * A))
-    flat = np.concatenate([grid.reshape(E, A, -1), vector, critic], axis=-1)
-    return flat.reshape(E * A, -1).astype(np.float32)
 
 
 def entry_dir(map_name: str, variant: str, zoo_dir=None) -> Path:
@@ -76,7 +62,8 @@ class ZooPolicy:
 
     ``predict(sim_state, state=None, episode_start=None, deterministic=True)`` returns
     ``(actions, state)``: actions (E, A, 2) int (message symbol shown this step, move), and the
-    recurrent state to pass back at the next call.
+    recurrent state to pass back at the next call. Phases, masks and the flat observation
+    come from :mod:`patrolsb3.core.protocol`, as in the training env.
     """
 
     def __init__(self, policy, spec, cfg: EnvConfig, info: dict):
@@ -84,15 +71,14 @@ class ZooPolicy:
         self.spec = spec
         self.cfg = cfg
         self.info = info
-        self.two_phase = cfg.two_phase
+        self.layout = protocol.ObservationLayout.of(spec, cfg)
         self.recurrent = hasattr(policy, "lstm_actor")
 
     def _act(self, sim_state, phase: int, lstm, starts):
-        message_mask, move_mask = composite_action_mask(self.spec, self.cfg, sim_state,
-                                                        message_phase=phase == 0)
+        decision = protocol.decide(self.spec, self.cfg, sim_state, phase)
         E, A = sim_state.pos.shape
-        masks = np.concatenate([message_mask, move_mask], axis=-1).reshape(E * A, -1)
-        obs = flat_observation(self.spec, self.cfg, sim_state, phase)
+        masks = decision.masks.reshape(E * A, -1)                              # (E*A, n_symbols + 5)
+        obs = decision.flat(self.layout).reshape(E * A, -1)                    # (E*A, layout.size)
         if self.recurrent:
             actions, lstm = self.policy.predict(obs, state=lstm, episode_start=starts,
                                                deterministic=self._deterministic, action_masks=masks)
@@ -123,19 +109,17 @@ class ZooPolicy:
         if episode_start is None:
             episode_start = np.full(E, state is None)
         starts = np.repeat(np.asarray(episode_start, dtype=bool), A)
-        active = sim.status == 0
-        if self.two_phase:
+        active = sim.active
+        if self.cfg.two_phase:
             silent = dataclasses.replace(sim, messages=np.zeros_like(sim.messages))
-            chosen, state = self._act(silent, 0, state, starts)
-            symbols = np.where(active, chosen[..., 0] + 1, 0)
+            chosen, state = self._act(silent, protocol.MESSAGE_PHASE, state, starts)
+            symbols = protocol.symbols_of(chosen[..., 0], active)
             shown = dataclasses.replace(sim, messages=symbols)
-            chosen, state = self._act(shown, 1, state, np.zeros_like(starts))
-            moves = chosen[..., 1]
+            chosen, state = self._act(shown, protocol.MOVE_PHASE, state, np.zeros_like(starts))
         else:
-            chosen, state = self._act(sim, 1, state, starts)
-            moves = chosen[..., 1]
-            symbols = np.where(active & (self.cfg.comm != "none"), chosen[..., 0] + 1, 0)
-        return np.stack([symbols, moves], axis=-1).astype(np.int64), state
+            chosen, state = self._act(sim, protocol.MOVE_PHASE, state, starts)
+            symbols = protocol.symbols_of(chosen[..., 0], active & (self.cfg.comm != "none"))
+        return np.stack([symbols, chosen[..., 1]], axis=-1).astype(np.int64), state
 
 
 def env_config(config: dict) -> EnvConfig:
@@ -241,8 +225,7 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None) -> ZooPolicy:
     except Exception as exc:  # a corrupt or foreign file: say which one
         raise ZooError(f"{folder / 'model.zip'}: cannot be loaded as a {policy_class.__name__} "
                        f"({type(exc).__name__}: {exc})") from exc
-    from .core.observe import vector_size
-    expected = (2 * spec.kinds.size + vector_size(cfg) + 3 * cfg.max_agents,)
+    expected = (protocol.ObservationLayout.of(spec, cfg).size,)
     if tuple(policy.observation_space.shape) != expected:
         raise ZooError(f"{folder / 'model.zip'}: the policy reads observations of shape "
                        f"{tuple(policy.observation_space.shape)}, this code makes {expected} "

@@ -49,7 +49,7 @@ class Recorder(BaseCallback):
         self.start_teams, self.stages, self.logged = None, [], []
 
     def _deployed(self):
-        return [self.venv.get_env(i).n_agents for i in range(self.venv.n_episodes)]
+        return self.venv.running_agents()
 
     def _on_training_start(self):
         self.start_teams = self._deployed()
@@ -82,7 +82,7 @@ def test_callback_walks_the_stages_and_switches_teams(venv):
     assert seen == [0, 1, 2, 3]
     assert curriculum.stage == 3
     assert venv.get_agents() == CURRICULUM[3]
-    assert [venv.get_env(i).n_agents for i in range(8)] == CURRICULUM[3]  # episodes of 3 steps
+    assert venv.running_agents() == CURRICULUM[3]  # episodes of 3 steps
     assert recorder.logged == recorder.stages
 
 

@@ -1,9 +1,14 @@
 """MaskableRecurrentPPO: stored log-probs are recomputed exactly over padded sequences with the
-stored masks, a strict env never gets a masked action, inactive slots have log-prob 0, and
-save / load keeps predict() with the recurrent state."""
+stored masks, a strict env never gets a masked action, inactive slots have log-prob 0, padded
+slots take no work (and the losses are the old way's restricted to deployed rows), and save /
+load keeps predict() with the recurrent state."""
+import copy
+
 import numpy as np
 import pytest
 import torch as th
+
+from sb3_contrib.common.recurrent.buffers import RecurrentRolloutBuffer
 
 from patrolsb3.core import parse_map
 from patrolsb3.sb3 import make_vec_env
@@ -14,11 +19,11 @@ th.set_num_threads(1)
 NON_SQUARE = "S..#..2\n.#.....\n...#5.."
 
 
-def tiny_model(agents=(1, 2, 3), episode_steps=6, n_steps=16, batch_size=50, seed=0, **kwargs):
+def tiny_model(agents=(1, 2, 3), episode_steps=6, n_steps=16, batch_size=50, seed=0, n_minibatches=None, **kwargs):
     env = make_vec_env(parse_map(NON_SQUARE, name="ns"), agents=agents, variant="rl-msg", seed=seed,
                        max_agents=3, episode_steps=episode_steps)
     model = MaskableRecurrentPPO(PatrolRecurrentPolicy, env, n_steps=n_steps, batch_size=batch_size, n_epochs=1,
-                                 seed=seed, device="cpu", gamma=0.95 ** 0.5,
+                                 seed=seed, device="cpu", gamma=0.95 ** 0.5, n_minibatches=n_minibatches,
                                  policy_kwargs=policy_kwargs_for(env.layout, dense_sizes=(32, 32),
                                                                  lstm_hidden_size=16, **kwargs))
     return model, env
@@ -47,7 +52,7 @@ def test_recomputed_log_probs_equal_stored(critic_lstm):
             assert th.allclose(log_prob[real], data.old_log_prob[real], atol=1e-5)
             assert th.allclose(values.flatten()[real], data.old_values[real], atol=1e-5)
             n_checked += int(real.sum())
-    assert n_checked == model.n_steps * model.n_envs
+    assert n_checked == model.n_steps * sum((1, 2, 3))   # deployed rows only
     assert bool((buffer.episode_starts[1:] == 1).any())   # episodes really restarted inside
 
 
@@ -73,7 +78,7 @@ def test_inactive_slots_have_log_prob_zero():
 def test_strict_env_learns_without_masked_actions():
     # strict env (invalid_action='raise'): any masked action would raise InvalidActionError / ValueError
     model, env = tiny_model(agents=(3, 3), n_steps=24)
-    assert env.get_env(0).cfg.invalid_action == "raise"
+    assert env.episode_config(0).invalid_action == "raise"
     model.learn(2 * model.n_steps * model.n_envs)
     assert model.num_timesteps == 2 * model.n_steps * model.n_envs
 
@@ -96,3 +101,60 @@ def test_save_load_predict_with_recurrent_state(tmp_path):
     fresh, _ = loaded.predict(obs, None, starts, deterministic=True, action_masks=masks)
     assert masks[np.arange(len(after)), after[:, 0]].all() and masks[np.arange(len(after)), 16 + after[:, 1]].all()
     assert fresh.shape == after.shape
+
+
+def test_padded_slots_are_not_run_through_the_rollout_forward():
+    model, env = tiny_model(agents=(1, 1, 2))           # 3 slots per episode: 4 of 9 rows deployed
+    rows_seen = []
+    forward = model.policy.forward
+    model.policy.forward = lambda obs, *a, **k: (rows_seen.append(obs.shape[0]), forward(obs, *a, **k))[1]
+    buffer = collect(model)
+    assert rows_seen == [4] * model.n_steps
+    assert buffer.deployed.sum(axis=1).tolist() == [4] * model.n_steps
+
+
+def _loss_and_grads(model, data, row_mask=None):
+    model.policy.optimizer.zero_grad()
+    loss, terms = model.minibatch_loss(data, clip_range=0.15, clip_range_vf=None, row_mask=row_mask)
+    loss.backward()
+    return loss.item(), terms, [p.grad.detach().clone() for p in model.policy.parameters()]
+
+
+def test_losses_and_gradients_equal_the_old_way_on_deployed_rows(monkeypatch):
+    """One rollout with padded slots: the skip's loss and gradients equal those of sb3-contrib's
+    whole-buffer minibatch (padded rows included) with the loss restricted to deployed rows;
+    the advantage normalisation of the skip sees deployed rows only."""
+    model, env = tiny_model(agents=(1, 1, 2))
+    buffer = collect(model)
+    old = copy.deepcopy(buffer)
+    with th.no_grad():                                   # ratios != 1: the policy loss has weight
+        for p in model.policy.parameters():
+            p.add_(0.01 * th.randn_like(p))
+    monkeypatch.setattr(np.random, "randint", lambda n: 0)
+    new_data = next(buffer.get(None))
+    assert int((new_data.mask > 0.5).sum()) == int(old.deployed.sum())
+    # the old way: every row in the minibatch, the loss masked to deployed rows
+    old.action_masks = old.swap_and_flatten(old.action_masks)
+    old.deployed = old.swap_and_flatten(old.deployed.astype(np.float32))
+    old_data = next(RecurrentRolloutBuffer.get(old, None))
+    deployed = old.pad_and_flatten(old.deployed[np.arange(old.n_envs * old.buffer_size)]) > 0.5
+    assert int(deployed.sum()) < int((old_data.mask > 0.5).sum())   # padded rows were there
+    new_loss, new_terms, new_grads = _loss_and_grads(model, new_data)
+    old_loss, old_terms, old_grads = _loss_and_grads(model, old_data, row_mask=deployed)
+    assert abs(new_terms["policy_loss"]) > 1e-6
+    assert new_loss == pytest.approx(old_loss, rel=1e-5, abs=1e-7)
+    for key in new_terms:
+        assert new_terms[key] == pytest.approx(old_terms[key], rel=1e-4, abs=1e-7), key
+    for new, old_grad in zip(new_grads, old_grads):
+        th.testing.assert_close(new, old_grad, rtol=1e-4, atol=1e-6)
+    # and the loss over every row (padded ones in the normalisation and the means) differs
+    every_loss, _, _ = _loss_and_grads(model, old_data)
+    assert every_loss != pytest.approx(new_loss, rel=1e-3)
+
+
+def test_n_minibatches_splits_the_deployed_rows():
+    model, env = tiny_model(agents=(1, 1, 2), n_minibatches=3)
+    collect(model)
+    assert model.update_batch_size() == -(-model.n_steps * 4 // 3)
+    sizes = [int((d.mask > 0.5).sum()) for d in model.rollout_buffer.get(model.update_batch_size())]
+    assert sum(sizes) == model.n_steps * 4 and len(sizes) == 3

@@ -1,5 +1,8 @@
-"""The parameter-shared SB3 vector env: spaces, flat layout, masks, episode ends, seeding."""
+"""The parameter-shared SB3 vector env: spaces, flat layout, masks, episode ends, seeding; its
+rows are the agent protocol's view of one batched simulator state."""
 from __future__ import annotations
+
+import copy
 
 import numpy as np
 import pytest
@@ -8,12 +11,12 @@ from sb3_contrib import MaskablePPO
 from sb3_contrib.common.maskable.utils import get_action_masks, is_masking_supported
 from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
-from patrolsb3.core import parse_map
+from patrolsb3.core import parse_map, protocol
 from patrolsb3.core.maps import STAY
 from patrolsb3.core.observe import VECTOR_SIZE
 from patrolsb3.env import PatrolParallelEnv
 from patrolsb3.sb3 import VARIANTS, make_vec_env
-from patrolsb3.sb3.vec_env import PatrolVecEnv, flatten_observation
+from patrolsb3.sb3.vec_env import PatrolVecEnv
 
 from conftest import NON_SQUARE
 
@@ -36,12 +39,10 @@ def masked_actions(masks, rng):
                      for m in masks], dtype=np.int64)
 
 
-def unflatten(row, layout):
-    """Split one flat observation back into the env's Dict layout."""
-    g = int(np.prod(layout["grid_shape"]))
-    v = layout["vector_size"]
-    return {"grid": row[:g].reshape(layout["grid_shape"]), "vector": row[g:g + v],
-            "critic": row[g + v:]}
+def the_state(venv):
+    """The batched simulator state of a vec env without per-episode settings (one group)."""
+    (group,) = venv.episodes.groups
+    return group.state
 
 
 def test_spaces_and_layout(spec):
@@ -51,13 +52,14 @@ def test_spaces_and_layout(spec):
     assert venv.observation_space.shape == (OBS_SIZE,)
     assert venv.observation_space.dtype == np.float32
     assert list(venv.action_space.nvec) == [16, 5]
-    assert venv.layout == {"grid_shape": (2, H, W), "vector_size": VECTOR_SIZE, "critic_size": 3 * A}
+    assert venv.layout == protocol.ObservationLayout((2, H, W), VECTOR_SIZE, 3 * A, A)
     obs = venv.reset()
     assert obs.shape == (venv.num_envs, OBS_SIZE) and obs.dtype == np.float32
     assert venv.observation_space.contains(obs[0])
     assert venv.action_masks().shape == (venv.num_envs, 21)
-    assert isinstance(venv.get_env(2), PatrolParallelEnv)
-    assert venv.get_env(2).n_agents == 5
+    assert venv.running_agents() == TEAMS
+    assert venv.deployed_rows().tolist() == [k % A < TEAMS[k // A] for k in range(venv.num_envs)]
+    assert the_state(venv).pos.shape == (len(TEAMS), A)     # one batched state for all episodes
 
 
 @pytest.mark.parametrize("variant,timing,phases", [
@@ -65,40 +67,44 @@ def test_spaces_and_layout(spec):
     ("rl-msg", "delayed", 1)])
 def test_variants_set_comm_and_phases(spec, variant, timing, phases):
     venv = make_vec_env(spec, agents=[1], variant=variant, message_timing=timing)
-    assert venv.get_env(0).cfg.comm == VARIANTS[variant]["comm"]
+    assert venv.episode_config(0).comm == VARIANTS[variant]["comm"]
     assert venv.phases_per_step == phases
 
 
-def test_rows_mirror_independent_envs(spec):
-    """Row e*A + s is slot s of an env reset with seed + e: obs layout, masks and rewards."""
-    seed = 11
-    venv = make_vec_env(spec, agents=TEAMS, seed=seed, episode_steps=50)
+@pytest.mark.parametrize("variant", sorted(VARIANTS))
+def test_rows_are_the_protocol_view_of_the_batched_state(spec, variant):
+    """Every step: rows and masks are protocol.decide of the batched state, rewards those of the
+    protocol applied to a copy of it, and the PettingZoo env shows one episode the same way."""
+    venv = make_vec_env(spec, agents=TEAMS, seed=11, variant=variant, episode_steps=50)
     obs = venv.reset()
-    envs = [PatrolParallelEnv(spec, n_agents=k, episode_steps=50) for k in TEAMS]
-    resets = [env.reset(seed=seed + e) for e, env in enumerate(envs)]
-    masks = venv.env_method("action_masks")
-    assert len(masks) == venv.num_envs
+    cfg = venv.episode_config(0)
+    pz = PatrolParallelEnv(spec, n_agents=1, config=cfg)
     rng = np.random.default_rng(0)
-    for t in range(6):
-        for e, env in enumerate(envs):
-            ref_obs, ref_infos = resets[e][0], resets[e][1]
-            for s, name in enumerate(env.possible_agents):
-                k = e * A + s
-                parts = unflatten(obs[k], venv.layout)
-                for key in ("grid", "vector", "critic"):
-                    np.testing.assert_array_equal(parts[key], ref_obs[name][key])
-                np.testing.assert_array_equal(flatten_observation(ref_obs[name]), obs[k])
-                message, move = ref_infos[name]["action_mask"]
-                np.testing.assert_array_equal(masks[k], np.concatenate([message, move]).astype(bool))
+    for t in range(8):
+        state, phase = the_state(venv), venv.episodes.phase
+        decision = protocol.decide(spec, cfg, state, phase)
+        np.testing.assert_array_equal(obs, decision.flat(venv.layout).reshape(venv.num_envs, -1))
+        np.testing.assert_array_equal(venv.action_masks(), decision.masks.reshape(venv.num_envs, -1))
+        np.testing.assert_array_equal(np.stack(venv.env_method("action_masks")), venv.action_masks())
+        for e in range(len(TEAMS)):              # the PettingZoo env's view of episode e
+            pz.core_state = copy.deepcopy(state)
+            for field in ("pos", "battery", "status", "swap_left", "p_dyn", "messages", "idle", "visited",
+                          "t", "n_agents"):
+                setattr(pz.core_state, field, getattr(state, field)[e:e + 1].copy())
+            pz._decide(phase)
+            for s_, name in enumerate(pz.possible_agents):
+                o = pz._observations()[name]
+                np.testing.assert_array_equal(venv.layout.flatten(o["grid"], o["vector"], o["critic"]),
+                                              obs[e * A + s_])
         actions = masked_actions(venv.action_masks(), rng)
+        mirror = copy.deepcopy(state)
+        info = protocol.apply_actions(spec, cfg, mirror, phase,
+                                      protocol.check_actions(cfg, phase, actions.reshape(len(TEAMS), A, 2),
+                                                             decision.masks))
         obs, rewards, dones, _ = venv.step(actions)
-        masks = venv.env_method("action_masks")
-        for e, env in enumerate(envs):
-            act = {name: actions[e * A + s] for s, name in enumerate(env.possible_agents)}
-            o, r, *_, i = env.step(act)
-            resets[e] = (o, i)
-            np.testing.assert_allclose(rewards[e * A:(e + 1) * A],
-                                       [r[name] for name in env.possible_agents], rtol=1e-6)
+        expected = np.zeros(venv.num_envs) if info is None else info.reward.reshape(-1)
+        np.testing.assert_allclose(rewards, expected, rtol=1e-6)
+        np.testing.assert_array_equal(the_state(venv).pos, mirror.pos)
         assert not dones.any()
 
 
@@ -153,14 +159,14 @@ def test_lenient_env_accepts_any_action(spec, variant):
 def test_horizon_marks_truncation_and_keeps_terminal_observation(spec, variant, env_steps):
     venv = make_vec_env(spec, agents=[2, 1], variant=variant, seed=4, episode_steps=5)
     obs = venv.reset()
-    mirror = PatrolParallelEnv(spec, n_agents=2, episode_steps=5, comm=VARIANTS[variant]["comm"])
-    mirror.reset(seed=4)
+    cfg = venv.episode_config(0)
     rng = np.random.default_rng(3)
     returns = np.zeros(venv.num_envs)
     for t in range(env_steps):
         actions = masked_actions(venv.action_masks(), rng)
+        mirror, phase = copy.deepcopy(the_state(venv)), venv.episodes.phase
+        masks = venv.action_masks().reshape(2, A, -1)
         obs, rewards, dones, infos = venv.step(actions)
-        m_obs, *_ = mirror.step({name: actions[s] for s, name in enumerate(mirror.possible_agents)})
         returns += rewards
         if t < env_steps - 1:
             assert not dones.any()
@@ -174,8 +180,11 @@ def test_horizon_marks_truncation_and_keeps_terminal_observation(spec, variant, 
         assert info["team_episode"]["sim_steps"] == 5
         assert info["team_episode"]["n_agents"] == (2 if k < A else 1)
     # the terminal observation is the last one of the finished episode; obs is the next one's
-    for s, name in enumerate(mirror.possible_agents):
-        np.testing.assert_array_equal(infos[s]["terminal_observation"], flatten_observation(m_obs[name]))
+    protocol.apply_actions(spec, cfg, mirror, phase,
+                           protocol.check_actions(cfg, phase, actions.reshape(2, A, 2), masks))
+    last = protocol.decide(spec, cfg, mirror, protocol.next_phase(cfg, phase)).flat(venv.layout)
+    np.testing.assert_array_equal(np.stack([i["terminal_observation"] for i in infos]),
+                                  last.reshape(venv.num_envs, -1))
     assert not np.array_equal(obs[0], infos[0]["terminal_observation"])
     team = infos[0]["team_episode"]
     assert team["reward"] == pytest.approx(returns[:2].mean(), rel=1e-5)
@@ -186,18 +195,26 @@ def test_horizon_marks_truncation_and_keeps_terminal_observation(spec, variant, 
 def test_episode_env_gives_one_parallel_episode_its_own_settings(spec):
     venv = make_vec_env(spec, agents=[2, 2], variant="rl-no-msg", seed=1, episode_steps=6,
                         episode_env={1: {"episode_steps": 3, "init_battery": [0.1, 0.1]}})
-    assert venv.get_env(0).cfg.episode_steps == 6 and venv.get_env(1).cfg.episode_steps == 3
+    assert venv.episode_config(0).episode_steps == 6 and venv.episode_config(1).episode_steps == 3
+    assert len(venv.episodes.groups) == 2        # one simulator call per distinct setting
     venv.reset()
-    b_max = venv.get_env(0).cfg.b_max
-    batteries = [venv.get_env(e).core_state.battery[0, :2] / b_max for e in (0, 1)]   # (2,) each
+    b_max = venv.episode_config(0).b_max
+    batteries = [g.state.battery[0, :2] / b_max for g in venv.episodes.groups]   # (2,) each
     assert (batteries[0] >= 0.9).all() and np.allclose(batteries[1], 0.1)
     rng = np.random.default_rng(0)
     ends = {}
     for t in range(1, 7):
-        _, _, dones, infos = venv.step(masked_actions(venv.action_masks(), rng))
+        before = venv.episodes.groups[1].state.copy()
+        obs, _, dones, infos = venv.step(masked_actions(venv.action_masks(), rng))
         for e in (0, 1):
             if dones[e * A] and e not in ends:
                 ends[e] = (t, infos[e * A]["team_episode"]["sim_steps"])
+        if t == 3:   # episode 1 ended alone: restarted in place, its terminal observation kept
+            assert not dones[:A].any() and dones[A:].all()
+            assert "terminal_observation" in infos[A] and "terminal_observation" not in infos[0]
+            assert not np.array_equal(infos[A]["terminal_observation"], obs[A])
+            assert venv.episodes.groups[1].state.t[0] == 0 and before.t[0] == 2
+            assert np.allclose(venv.episodes.groups[1].state.battery[0, :2] / b_max, 0.1)
     assert ends == {1: (3, 3), 0: (6, 6)}
 
 
@@ -229,16 +246,16 @@ def test_set_agents_takes_effect_at_next_episode(spec):
     assert venv.get_agents() == [4, 2]
     stay = np.tile([0, STAY], (venv.num_envs, 1))
     venv.step(stay)
-    assert venv.get_env(0).n_agents == 1  # the running episode keeps its team
+    assert venv.running_agents() == [1, 1]  # the running episode keeps its team
     assert venv.action_masks()[1, 16:].sum() == 1  # slot 1 still padded
     for _ in range(2):
         _, _, dones, infos = venv.step(stay)
     assert dones.all()
     assert infos[0]["team_episode"]["n_agents"] == 1  # the summary is the finished episode's
-    assert [venv.get_env(i).n_agents for i in range(2)] == [4, 2]
+    assert venv.running_agents() == [4, 2]
     assert venv.get_attr("n_agents") == [4] * A + [2] * A
-    status = [i["status"] for i in infos]  # reset infos of the new episodes
-    assert status == ["active"] * 4 + ["absent"] + ["active"] * 2 + ["absent"] * 3
+    assert venv.deployed_rows().tolist() == [True] * 4 + [False] + [True] * 2 + [False] * 3
+    assert (venv.action_masks()[:, 16:].sum(1)[~venv.deployed_rows()] == 1).all()
     for _ in range(3):
         _, _, dones, infos = venv.step(stay)
     assert dones.all()
@@ -286,7 +303,7 @@ def test_seeding_reproduces_runs_across_auto_resets(spec):
     for x, y in zip(a, b):
         np.testing.assert_array_equal(x, y)
     c = make_vec_env(spec, seed=99, **kw)
-    assert c.seed(5) == [5] * A + [6] * A
+    assert c.seed(5) == [5] * (2 * A)
     for x, y in zip(a, run_fixed(c, 20, seed=0)):
         np.testing.assert_array_equal(x, y)
     d = run_fixed(make_vec_env(spec, seed=6, **kw), 20, seed=0)

@@ -8,8 +8,7 @@ import torch
 import yaml
 
 from patrolsb3 import zoo
-from patrolsb3.core import load_map, make_config, reset_state
-from patrolsb3.core.masks import composite_action_mask
+from patrolsb3.core import load_map, make_config, protocol, reset_state
 from patrolsb3.evaluate import run_episodes
 from patrolsb3.sb3 import make_vec_env
 from patrolsb3.sb3.maskable_recurrent_ppo import MaskableRecurrentPPO
@@ -72,20 +71,6 @@ def test_export_of_a_warm_started_run_counts_both_stages(trained, tmp_path):
     assert budget["timesteps_this_run"] == 320 and budget["timesteps"] == 320 + first
 
 
-def test_flat_observation_is_the_training_layout():
-    vec = make_vec_env(map="B", agents=[3], variant="rl-msg", seed=3)
-    obs = vec.reset()                                                    # (5, D)
-    env = vec.get_env(0)
-    flat = zoo.flat_observation(env.spec_map, env.cfg, env.core_state, phase=0)
-    np.testing.assert_array_equal(flat, obs)
-    actions = np.array([[2, 4], [2, 4], [2, 4], [0, 4], [0, 4]])         # slots 3, 4 absent: silent
-    obs, _, _, _ = vec.step(actions)                                     # message phase -> move phase
-    flat = zoo.flat_observation(env.spec_map, env.cfg, env.core_state, phase=1)
-    np.testing.assert_array_equal(flat, obs)
-    assert flat[0, 2 * 12 * 12 + 6] == 1.0                               # the phase flag
-    assert env.core_state.messages[0, 0] == 3                           # symbol = index + 1
-
-
 def test_zoo_policy_acts_like_the_trained_model(trained):
     policy = zoo.load("ROOM", "rl-msg", zoo_dir=trained["root"] / "zoo", spec=trained["map_file"])
     model = MaskableRecurrentPPO.load(str(trained["run"] / "model.zip"), device="cpu")
@@ -97,18 +82,18 @@ def test_zoo_policy_acts_like_the_trained_model(trained):
     E, A = sim.pos.shape
     silent = sim.copy()
     silent.messages[:] = 0
-    msg_mask, move_mask = composite_action_mask(spec, policy.cfg, silent, message_phase=True)
-    masks = np.concatenate([msg_mask, move_mask], -1).reshape(E * A, -1)
-    first, state = model.predict(zoo.flat_observation(spec, policy.cfg, silent, 0), state=None,
-                                 episode_start=np.ones(E * A, bool), deterministic=True, action_masks=masks)
+    decision = protocol.decide(spec, policy.cfg, silent, protocol.MESSAGE_PHASE)
+    first, state = model.predict(decision.flat(policy.layout).reshape(E * A, -1), state=None,
+                                 episode_start=np.ones(E * A, bool), deterministic=True,
+                                 action_masks=decision.masks.reshape(E * A, -1))
     symbols = np.where(sim.status == 0, first[:, 0].reshape(E, A) + 1, 0)
     np.testing.assert_array_equal(actions[..., 0], symbols)
     shown = sim.copy()
     shown.messages = symbols
-    msg_mask, move_mask = composite_action_mask(spec, policy.cfg, shown, message_phase=False)
-    masks = np.concatenate([msg_mask, move_mask], -1).reshape(E * A, -1)
-    second, _ = model.predict(zoo.flat_observation(spec, policy.cfg, shown, 1), state=state,
-                              episode_start=np.zeros(E * A, bool), deterministic=True, action_masks=masks)
+    decision = protocol.decide(spec, policy.cfg, shown, protocol.MOVE_PHASE)
+    second, _ = model.predict(decision.flat(policy.layout).reshape(E * A, -1), state=state,
+                              episode_start=np.zeros(E * A, bool), deterministic=True,
+                              action_masks=decision.masks.reshape(E * A, -1))
     np.testing.assert_array_equal(actions[..., 1], second[:, 1].reshape(E, A))
     assert (actions[..., 1][sim.status != 0] == 4).all()
 
@@ -181,12 +166,10 @@ def test_refusals_name_the_problem(trained, tmp_path):
 
 
 def test_the_local_idleness_layout_travels_with_the_checkpoint(trained, tmp_path):
-    # the vec env and the zoo build the same rows with the local idleness on
+    # the vec env's rows carry the local idleness
     vec = make_vec_env(map="B", agents=[3], variant="rl-no-msg", seed=3, local_idleness=True)
     obs = vec.reset()
-    env = vec.get_env(0)
     assert obs.shape == (5, 2 * 12 * 12 + 20 + 15)
-    np.testing.assert_array_equal(zoo.flat_observation(env.spec_map, env.cfg, env.core_state, phase=1), obs)
     # a run trained with it exports, loads and acts with it (its config.yml says so)
     hp = {"n_steps": 16, "n_minibatches": 2, "n_envs": 2, "eval_freq": 0, "checkpoint_freq": 10**9,
           "env": {"episode_steps": 20, "local_idleness": True},

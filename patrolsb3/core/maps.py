@@ -100,6 +100,14 @@ class MapSpec:
         steps[self.free_cells] = self.nearest_station(self.free_cells)[0]
         return steps
 
+    @functools.cached_property
+    def home_move(self) -> np.ndarray:
+        """(H*W,) int8 first move of a shortest path from each free cell to its nearest station
+        (STAY on a station and on obstacles): :meth:`nearest_station` as a table."""
+        moves = np.full(self.kinds.size, STAY, dtype=np.int8)
+        moves[self.free_cells] = self.nearest_station(self.free_cells)[1]
+        return moves
+
     def cell_distance(self, a, b) -> np.ndarray:
         """Shortest-path length between cell indices ``a`` and ``b`` (broadcasting arrays)."""
         return self.dist[self.free_index[a], self.free_index[b]]

@@ -143,7 +143,8 @@ def move_allowed(spec: MapSpec, state: State, moves: np.ndarray) -> np.ndarray:
     return np.where(state.active, ok | (moves == STAY), moves == STAY)
 
 
-def composite_action_mask(spec: MapSpec, cfg, state: State, message_phase: bool) -> tuple[np.ndarray, np.ndarray]:
+def composite_action_mask(spec: MapSpec, cfg, state: State, message_phase: bool,
+                          move_mask: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Masks of the composite (message, move) action for every slot, in one phase.
 
     * Message phase (same-step messages): the move must be Stay; an active slot may send any
@@ -158,11 +159,12 @@ def composite_action_mask(spec: MapSpec, cfg, state: State, message_phase: bool)
         cfg: environment parameters (comm, message_timing, n_symbols).
         state: batched state.
         message_phase: True in the message phase of a same-step exchange.
+        move_mask: (E, A, 5) :func:`action_mask` of ``state`` if already computed.
 
     Returns:
         message (E, A, n_symbols) bool and move (E, A, 5) bool.
     """
-    move = action_mask(spec, state, cfg)                                   # (E, A, 5)
+    move = action_mask(spec, state, cfg) if move_mask is None else move_mask  # (E, A, 5)
     E, A = state.pos.shape
     message = np.zeros((E, A, cfg.n_symbols), dtype=bool)
     chooses_message = cfg.comm != "none" and (message_phase or cfg.message_timing == "delayed")

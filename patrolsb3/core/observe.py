@@ -37,6 +37,8 @@ or failed slot is padded with battery 1 and the station's position (the paper's 
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .config import EnvConfig
@@ -49,6 +51,7 @@ VECTOR_SIZE = 15
 """Length of the actor's vector observation without the local idleness."""
 LOCAL_IDLENESS_SIZE = 5
 """Values the local idleness adds (one per move)."""
+_ONE_HOT = np.eye(5, dtype=np.float32)  # (5, 5) one-hot row of each move
 
 
 def vector_size(cfg: EnvConfig) -> int:
@@ -63,13 +66,26 @@ def home_features(spec: MapSpec, cfg: EnvConfig, state: State) -> np.ndarray:
         (E, A, 7) float32, zeros for inactive slots.
     """
     H, W = spec.shape
-    steps_home, first = spec.nearest_station(state.pos)                       # (E, A), (E, A)
-    out = np.zeros(state.pos.shape + (7,), dtype=np.float32)
+    steps_home = spec.steps_home[state.pos]                                    # (E, A)
+    out = np.empty(state.pos.shape + (7,), dtype=np.float32)
     out[..., 0] = np.minimum(steps_home / (H + W), 1.0)
     out[..., 1] = np.clip((state.battery - steps_home * cfg.drain[1]) / cfg.b_max, -1.0, 1.0)
-    np.put_along_axis(out[..., 2:], first[..., None].astype(np.int64), 1.0, axis=-1)
+    out[..., 2:] = _ONE_HOT[spec.home_move[state.pos]]
     out[~state.active] = 0.0
     return out
+
+
+@functools.lru_cache(maxsize=64)
+def _position_base(spec: MapSpec) -> np.ndarray:
+    """(H*W,) float32 channel 0 without agents: vertex 0, obstacle -1, station +1."""
+    kinds = spec.kinds.ravel()
+    return np.where(kinds == OBSTACLE, -1.0, np.where(kinds == STATION, 1.0, 0.0)).astype(np.float32)
+
+
+@functools.lru_cache(maxsize=64)
+def _idleness_base(spec: MapSpec) -> np.ndarray:
+    """(H*W,) float32 channel 1 before the vertices are filled: obstacle -1, else 0."""
+    return np.where(spec.kinds.ravel() == OBSTACLE, -1.0, 0.0).astype(np.float32)
 
 
 def grid_size(spec: MapSpec) -> int:
@@ -95,24 +111,23 @@ def actor_observation(spec: MapSpec, cfg: EnvConfig, state: State, phase: int = 
     H, W = spec.shape
     scale = float(cfg.n_symbols + 2)
     kinds = spec.kinds.ravel()
-    base = np.where(kinds == OBSTACLE, -1.0, np.where(kinds == STATION, 1.0, 0.0)).astype(np.float32)
-    chan0 = np.broadcast_to(base, (E, A, H * W)).copy()                      # (E, A, H*W)
-    active = state.active
+    active = state.active                                                      # (E, A)
     value = (1.0 + state.messages) / scale                                     # (E, A) slot j's value
-    on_station = (kinds == STATION)[state.pos]                                 # (E, A)
-    e_idx, i_idx, j_idx = np.meshgrid(np.arange(E), np.arange(A), np.arange(A), indexing="ij")
-    draw_other = (active[:, None, :] & ~on_station[:, None, :]) & (i_idx != j_idx)  # (E, A, A)
-    chan0[e_idx[draw_other], i_idx[draw_other], state.pos[e_idx[draw_other], j_idx[draw_other]]] = \
-        -value[e_idx[draw_other], j_idx[draw_other]]
+    # what every observer sees of the others: agents off the station, drawn negative (active
+    # agents never share a cell off the station, so no two writes collide)
+    shared = np.broadcast_to(_position_base(spec), (E, H * W)).copy()         # (E, H*W)
+    drawn = active & (kinds != STATION)[state.pos]                             # (E, A)
+    e_d, j_d = np.nonzero(drawn)
+    shared[e_d, state.pos[e_d, j_d]] = -value[e_d, j_d]
+    grid = np.empty((E, A, 2, H * W), dtype=np.float32)
+    grid[:, :, 0] = shared[:, None, :]
+    # each active observer sees itself positive on its own cell (station included)
     e_s, i_s = np.nonzero(active)
-    chan0[e_s, i_s, state.pos[e_s, i_s]] = value[e_s, i_s]
+    grid[e_s, i_s, 0, state.pos[e_s, i_s]] = value[e_s, i_s]
 
     f = normalised_idleness(state.idle, state.visited, cfg.c_norm)              # (E, V)
-    idle_grid = np.where(kinds == OBSTACLE, -1.0, 0.0).astype(np.float32)
-    chan1 = np.broadcast_to(idle_grid, (E, H * W)).copy()
+    chan1 = np.broadcast_to(_idleness_base(spec), (E, H * W)).copy()            # (E, H*W)
     chan1[:, spec.vertex_cells] = f
-    grid = np.empty((E, A, 2, H * W), dtype=np.float32)
-    grid[:, :, 0] = chan0
     grid[:, :, 1] = chan1[:, None, :]
 
     if mask is None:

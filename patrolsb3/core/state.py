@@ -93,3 +93,22 @@ def reset_state(spec: MapSpec, cfg: EnvConfig, n_agents, n_envs: int = 1, seed=N
                  swap_left=np.zeros((n_envs, A), dtype=np.int64), p_dyn=p_dyn,
                  messages=np.zeros((n_envs, A), dtype=np.int64), idle=idle, visited=visited,
                  t=np.zeros(n_envs, dtype=np.int64), n_agents=n_agents, rng=rng)
+
+
+def reset_episodes(spec: MapSpec, cfg: EnvConfig, state: State, episodes: np.ndarray,
+                   n_agents) -> None:
+    """Restart some episodes of a batch in place (the others go on), drawing from the batch's
+    generator: how one batched call serves parallel episodes that end at different steps.
+
+    Args:
+        spec: the map.
+        cfg: environment parameters.
+        state: batched state, modified in place.
+        episodes: (k,) int indices of the episodes to restart.
+        n_agents: agents of each restarted episode, an int or (k,).
+    """
+    episodes = np.asarray(episodes, dtype=np.int64)
+    fresh = reset_state(spec, cfg, n_agents, n_envs=len(episodes), rng=state.rng)
+    for field in dataclasses.fields(State):
+        if field.name != "rng":
+            getattr(state, field.name)[episodes] = getattr(fresh, field.name)

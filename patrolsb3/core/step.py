@@ -175,7 +175,7 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
     shaping = compute_reward and cfg.c_home > 0
     if shaping:
         home_scale = float(sum(spec.shape))
-        phi_before = home_potential(spec.nearest_station(pos)[0], state.battery, cfg, home_scale)
+        phi_before = home_potential(spec.steps_home[pos], state.battery, cfg, home_scale)
     # 3. pushes by the environment
     pushed = acted & (rng.random((E, A)) < state.p_dyn)
     push_dir = rng.integers(0, 4, size=(E, A))
@@ -228,7 +228,7 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
         reward_collision = np.where(acted, collision_reward(collided, cfg), 0.0)
         reward_home = np.zeros((E, A))
         if shaping:
-            phi_after = home_potential(spec.nearest_station(state.pos)[0], state.battery, cfg, home_scale)
+            phi_after = home_potential(spec.steps_home[state.pos], state.battery, cfg, home_scale)
             reward_home = np.where(acted & ~battery_failed & ~fault_failed, phi_after - phi_before, 0.0)
         reward = reward_patrol + reward_battery + reward_collision + reward_home
     else:

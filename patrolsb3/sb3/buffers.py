@@ -1,5 +1,15 @@
 """sb3-contrib's RecurrentRolloutBuffer that also stores the action masks of every step
-(what MaskableRolloutBuffer adds to RolloutBuffer), padded into the same sequences."""
+(what MaskableRolloutBuffer adds to RolloutBuffer), padded into the same sequences, and
+trains on deployed rows only.
+
+Rows of slots that their episode does not deploy (a team smaller than ``max_agents``) stay in
+the buffer, since SB3 fixes ``n_envs``, but never reach a minibatch: when the buffer is
+prepared, every field is cut down to the deployed steps (in env-major order, as
+sb3-contrib flattens them), and a sequence boundary is put wherever that cut joins two
+stretches that were not consecutive. Sequences are then built and padded exactly as
+sb3-contrib does; the advantage normalisation of each minibatch therefore sees deployed rows
+only.
+"""
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -35,28 +45,81 @@ def mask_dims(action_space: spaces.Space) -> int:
     raise ValueError(f"action masks need a Discrete or MultiDiscrete action space, got {action_space}")
 
 
-class MaskableRecurrentRolloutBuffer(RecurrentRolloutBuffer):
-    """Recurrent rollout buffer with action masks (see module docstring).
+_FLAT_FIELDS = ("observations", "actions", "values", "log_probs", "advantages", "returns",
+                "hidden_states_pi", "cell_states_pi", "hidden_states_vf", "cell_states_vf",
+                "episode_starts", "action_masks", "deployed")
+_LSTM_FIELDS = ("hidden_states_pi", "cell_states_pi", "hidden_states_vf", "cell_states_vf")
 
-    ``action_masks``: (n_steps, n_envs, mask_dims) float32 while filling, then flattened
-    env-major to (n_envs * n_steps, mask_dims) like every other field.
+
+def sequence_breaks(kept: np.ndarray, n_steps: int) -> np.ndarray:
+    """Where a new sequence must start among kept env-major rows.
+
+    Args:
+        kept: (K,) increasing indices into the env-major flattening (env * n_steps + step).
+        n_steps: steps per env in the buffer.
+
+    Returns:
+        (K,) float32, 1 where row j starts another env's data or follows a gap, else 0.
+    """
+    breaks = np.ones(len(kept), dtype=np.float32)
+    if len(kept) > 1:
+        breaks[1:] = (kept[1:] != kept[:-1] + 1) | (kept[1:] % n_steps == 0)
+    return breaks
+
+
+class MaskableRecurrentRolloutBuffer(RecurrentRolloutBuffer):
+    """Recurrent rollout buffer with action masks and deployed-row flags (module docstring).
+
+    While filling: ``action_masks`` (n_steps, n_envs, mask_dims) float32 and ``deployed``
+    (n_steps, n_envs) bool. Once prepared by :meth:`get`: every field flattened env-major and
+    cut to the deployed rows, ``n_rows`` of them, with ``env_change`` (n_rows, 1) the sequence
+    breaks.
     """
 
     def reset(self) -> None:
         self.mask_dims = mask_dims(self.action_space)
         self.action_masks = np.ones((self.buffer_size, self.n_envs, self.mask_dims), dtype=np.float32)
+        self.deployed = np.ones((self.buffer_size, self.n_envs), dtype=bool)
+        self.n_rows = self.buffer_size * self.n_envs
+        self.env_change = None
         super().reset()
 
-    def add(self, *args, action_masks: np.ndarray | None = None, **kwargs) -> None:
-        """RecurrentRolloutBuffer.add plus the (n_envs, mask_dims) masks of this step."""
+    def add(self, *args, action_masks: np.ndarray | None = None, deployed: np.ndarray | None = None,
+            **kwargs) -> None:
+        """RecurrentRolloutBuffer.add plus the (n_envs, mask_dims) masks of this step and the
+        (n_envs,) flags of the rows that are deployed (None: all)."""
         if action_masks is not None:
             self.action_masks[self.pos] = np.asarray(action_masks).reshape((self.n_envs, self.mask_dims))
+        self.deployed[self.pos] = True if deployed is None else np.asarray(deployed, dtype=bool)
         super().add(*args, **kwargs)
 
+    def prepare(self) -> None:
+        """Flatten every field env-major and keep the deployed rows only (once per rollout)."""
+        if self.generator_ready:
+            return
+        for name in _LSTM_FIELDS:   # (n_steps, layers, n_envs, hidden) -> (n_steps, n_envs, layers, hidden)
+            self.__dict__[name] = self.__dict__[name].swapaxes(1, 2)
+        for name in _FLAT_FIELDS:
+            self.__dict__[name] = self.swap_and_flatten(self.__dict__[name])
+        kept = np.flatnonzero(self.deployed.reshape(-1))                    # (n_rows,)
+        if len(kept) < len(self.deployed):
+            for name in _FLAT_FIELDS:
+                self.__dict__[name] = self.__dict__[name][kept]
+        self.n_rows = len(kept)
+        self.env_change = sequence_breaks(kept, self.buffer_size)[:, None]   # (n_rows, 1) like the fields
+        self.generator_ready = True
+
     def get(self, batch_size: int | None = None):
-        if not self.generator_ready:
-            self.action_masks = self.swap_and_flatten(self.action_masks)
-        yield from super().get(batch_size)
+        """Minibatches of about ``batch_size`` deployed rows (all of them when None), in
+        sb3-contrib's order: the rows from a random split point on, then the rest."""
+        assert self.full, "Rollout buffer must be full before sampling from it"
+        self.prepare()
+        n = self.n_rows
+        batch_size = n if batch_size is None else int(batch_size)
+        split_index = np.random.randint(n)
+        indices = np.concatenate((np.arange(split_index, n), np.arange(split_index)))
+        for start in range(0, n, batch_size):
+            yield self._get_samples(indices[start:start + batch_size], self.env_change)
 
     def _get_samples(self, batch_inds: np.ndarray, env_change: np.ndarray, env=None) -> MaskableRecurrentRolloutBufferSamples:
         samples = super()._get_samples(batch_inds, env_change, env)

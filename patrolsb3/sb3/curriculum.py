@@ -104,7 +104,7 @@ class CurriculumCallback(BaseCallback):
     def _on_training_start(self) -> None:
         self._apply(self._stage_now())
         env = find_set_agents(self.training_env)
-        deployed = [env.get_env(i).n_agents for i in range(env.n_episodes)]
+        deployed = env.running_agents()
         if deployed != env.get_agents() and getattr(self.model, "_last_obs", None) is not None:
             self._restart_episodes()
         self.logger.record("curriculum/stage", self.stage)

@@ -63,11 +63,10 @@ def evaluate(model, vec_env, deterministic: bool = True, max_env_steps: int | No
         One ``team_episode`` dict per parallel episode, in order (reward, n_agents,
         mean_idleness, max_idleness, collisions, battery_failures, sim_steps).
     """
-    max_agents = vec_env.layout["critic_size"] // 3
+    max_agents = vec_env.layout.max_agents
     n_episodes = vec_env.num_envs // max_agents
     if max_env_steps is None:
-        cfg = vec_env.get_env(0).cfg if hasattr(vec_env, "get_env") else None
-        horizon = cfg.episode_steps if cfg is not None else 10**6
+        horizon = max(vec_env.episode_config(e).episode_steps for e in range(n_episodes))
         max_env_steps = 2 * horizon * getattr(vec_env, "phases_per_step", 2) + 10
     masked, recurrent = _takes_masks(model), _is_recurrent(model)
     obs = vec_env.reset()

@@ -7,6 +7,15 @@ buffer (:class:`MaskableRecurrentRolloutBuffer`), and applied when actions are s
 the log-probs are recomputed in ``train`` and in ``predict``. With masks, an action a
 strict env would refuse is never sampled, and a slot with a single legal action has
 log-prob exactly 0 (no gradient through the policy loss).
+
+Padded slots (rows of an env's ``deployed_rows()`` that are False: slots a smaller team does
+not deploy) take no work: the rollout runs the policy on deployed rows only (a padded row
+takes its single legal action, value and log-prob 0), and the buffer keeps them out of every
+minibatch (:class:`MaskableRecurrentRolloutBuffer`). An env without ``deployed_rows`` has every
+row deployed.
+
+Minibatches: ``batch_size`` rows (deployed ones), or, with ``n_minibatches`` given, the
+deployed rows of each rollout split into that many minibatches.
 """
 from __future__ import annotations
 
@@ -17,11 +26,26 @@ import numpy as np
 import torch as th
 from sb3_contrib import RecurrentPPO
 from sb3_contrib.common.maskable.utils import get_action_masks, is_masking_supported
+from sb3_contrib.common.recurrent.type_aliases import RNNStates
 from stable_baselines3.common.utils import explained_variance, obs_as_tensor
 from stable_baselines3.common.vec_env import VecEnv
 
 from .buffers import MaskableRecurrentRolloutBuffer
 from .policy import PatrolRecurrentPolicy
+
+
+def env_deployed_rows(env: VecEnv) -> np.ndarray:
+    """(num_envs,) bool rows the policy acts for: the vec env's ``deployed_rows()``, else all."""
+    method = getattr(env, "deployed_rows", None)
+    if callable(method):
+        return np.asarray(method(), dtype=bool)
+    return np.ones(env.num_envs, dtype=bool)
+
+
+def first_legal_actions(masks: np.ndarray, nvec: np.ndarray) -> np.ndarray:
+    """(n, len(nvec)) the first legal value of each action dimension of (n, sum(nvec)) masks."""
+    bounds = np.concatenate([[0], np.cumsum(nvec)])
+    return np.stack([np.argmax(masks[:, a:b], axis=1) for a, b in zip(bounds[:-1], bounds[1:])], axis=1)
 
 
 def env_action_masks(env: VecEnv) -> np.ndarray:
@@ -43,6 +67,23 @@ class MaskableRecurrentPPO(RecurrentPPO):
     """
 
     policy_aliases: ClassVar[dict] = {"PatrolRecurrentPolicy": PatrolRecurrentPolicy}
+
+    def __init__(self, *args, n_minibatches: int | None = None, **kwargs):
+        """Args as :class:`sb3_contrib.RecurrentPPO`, plus ``n_minibatches``: when given, each
+        update splits the rollout's deployed rows into that many minibatches (``batch_size``
+        is then ignored)."""
+        if n_minibatches is not None and int(n_minibatches) < 1:
+            raise ValueError(f"n_minibatches must be >= 1, got {n_minibatches}")
+        self.n_minibatches = None if n_minibatches is None else int(n_minibatches)
+        super().__init__(*args, **kwargs)
+
+    def update_batch_size(self) -> int:
+        """Rows per minibatch of the coming update (``n_minibatches`` splits the rollout)."""
+        n_minibatches = getattr(self, "n_minibatches", None)    # absent in older checkpoints
+        if n_minibatches is None:
+            return int(self.batch_size)
+        self.rollout_buffer.prepare()
+        return max(1, -(-self.rollout_buffer.n_rows // n_minibatches))
 
     def _setup_model(self) -> None:
         super()._setup_model()
@@ -66,14 +107,12 @@ class MaskableRecurrentPPO(RecurrentPPO):
         lstm_states = deepcopy(self._last_lstm_states)
         dones = self._last_episode_starts
         new_obs = self._last_obs
+        nvec = self.action_space.nvec
         while n_steps < n_rollout_steps:
             action_masks = env_action_masks(env)                                   # (n_envs, 21)
-            with th.no_grad():
-                obs_tensor = obs_as_tensor(self._last_obs, self.device)
-                episode_starts = th.tensor(self._last_episode_starts, dtype=th.float32, device=self.device)
-                actions, values, log_probs, lstm_states = self.policy(
-                    obs_tensor, lstm_states, episode_starts, action_masks=th.as_tensor(action_masks))
-            actions = actions.cpu().numpy()
+            deployed = env_deployed_rows(env)                                      # (n_envs,)
+            actions, values, log_probs, lstm_states = self._act_deployed(
+                self._last_obs, lstm_states, self._last_episode_starts, action_masks, deployed, nvec)
             new_obs, rewards, dones, infos = env.step(actions)
             self.num_timesteps += env.num_envs
             callback.update_locals(locals())
@@ -81,9 +120,9 @@ class MaskableRecurrentPPO(RecurrentPPO):
                 return False
             self._update_info_buffer(infos, dones)
             n_steps += 1
-            self._bootstrap_truncated(rewards, dones, infos, lstm_states)
+            self._bootstrap_truncated(rewards, dones, infos, lstm_states, deployed)
             rollout_buffer.add(self._last_obs, actions, rewards, self._last_episode_starts, values, log_probs,
-                               lstm_states=self._last_lstm_states, action_masks=action_masks)
+                               lstm_states=self._last_lstm_states, action_masks=action_masks, deployed=deployed)
             self._last_obs = new_obs
             self._last_episode_starts = dones
             self._last_lstm_states = lstm_states
@@ -94,10 +133,49 @@ class MaskableRecurrentPPO(RecurrentPPO):
         callback.on_rollout_end()
         return True
 
-    def _bootstrap_truncated(self, rewards: np.ndarray, dones: np.ndarray, infos: list, lstm_states) -> None:
-        """Add gamma * V(terminal observation) to the rewards (n_envs,) of rows cut by the
-        time limit (SB3 issue #633), in one batched critic call."""
-        rows = [i for i, done in enumerate(dones) if done and infos[i].get("terminal_observation") is not None
+    def _act_deployed(self, obs: np.ndarray, lstm_states, episode_starts: np.ndarray, action_masks: np.ndarray,
+                      deployed: np.ndarray, nvec: np.ndarray):
+        """The policy's forward pass on the deployed rows only.
+
+        Returns:
+            actions (n_envs, len(nvec)) numpy, values (n_envs, 1), log-probs (n_envs,) and the
+            new LSTM states; padded rows get their first legal action, value 0, log-prob 0 and
+            keep their LSTM state.
+        """
+        rows = np.flatnonzero(deployed)
+        every = len(rows) == len(deployed)
+        index = slice(None) if every else th.as_tensor(rows, device=self.device)
+        with th.no_grad():
+            obs_tensor = obs_as_tensor(obs[rows] if not every else obs, self.device)
+            starts = th.tensor(episode_starts[rows] if not every else episode_starts, dtype=th.float32,
+                               device=self.device)
+            masks = th.as_tensor(action_masks[rows] if not every else action_masks, device=self.device)
+            sub_states = RNNStates((lstm_states.pi[0][:, index], lstm_states.pi[1][:, index]),
+                                   (lstm_states.vf[0][:, index], lstm_states.vf[1][:, index]))
+            actions, values, log_probs, states = self.policy(obs_tensor, sub_states, starts, action_masks=masks)
+        if every:
+            return actions.cpu().numpy(), values, log_probs, states
+        all_actions = first_legal_actions(action_masks, nvec)                    # (n_envs, len(nvec))
+        all_actions[rows] = actions.cpu().numpy()
+        all_values = th.zeros((len(deployed), 1), device=self.device)
+        all_values[index] = values
+        all_log_probs = th.zeros(len(deployed), device=self.device)
+        all_log_probs[index] = log_probs
+        merged = []
+        for old, new in ((lstm_states.pi, states.pi), (lstm_states.vf, states.vf)):
+            pair = []
+            for old_t, new_t in zip(old, new):
+                t = old_t.clone()
+                t[:, index] = new_t
+                pair.append(t)
+            merged.append(tuple(pair))
+        return all_actions, all_values, all_log_probs, RNNStates(*merged)
+
+    def _bootstrap_truncated(self, rewards: np.ndarray, dones: np.ndarray, infos: list, lstm_states,
+                             deployed: np.ndarray) -> None:
+        """Add gamma * V(terminal observation) to the rewards (n_envs,) of deployed rows cut by
+        the time limit (SB3 issue #633), in one batched critic call."""
+        rows = [i for i in np.flatnonzero(dones & deployed) if infos[i].get("terminal_observation") is not None
                 and infos[i].get("TimeLimit.truncated", False)]
         if not rows:
             return
@@ -118,34 +196,14 @@ class MaskableRecurrentPPO(RecurrentPPO):
         continue_training = True
         for epoch in range(self.n_epochs):
             approx_kl_divs = []
-            for data in self.rollout_buffer.get(self.batch_size):
-                mask = data.mask > 1e-8                                            # real (not padded) steps
-                values, log_prob, entropy = self.policy.evaluate_actions(
-                    data.observations, data.actions, data.lstm_states, data.episode_starts,
-                    action_masks=data.action_masks)
-                values = values.flatten()
-                advantages = data.advantages
-                if self.normalize_advantage:
-                    advantages = (advantages - advantages[mask].mean()) / (advantages[mask].std() + 1e-8)
-                ratio = th.exp(log_prob - data.old_log_prob)
-                policy_loss_1 = advantages * ratio
-                policy_loss_2 = advantages * th.clamp(ratio, 1 - clip_range, 1 + clip_range)
-                policy_loss = -th.mean(th.min(policy_loss_1, policy_loss_2)[mask])
-                pg_losses.append(policy_loss.item())
-                clip_fractions.append(th.mean((th.abs(ratio - 1) > clip_range).float()[mask]).item())
-                if clip_range_vf is None:
-                    values_pred = values
-                else:
-                    values_pred = data.old_values + th.clamp(values - data.old_values, -clip_range_vf, clip_range_vf)
-                value_loss = th.mean(((data.returns - values_pred) ** 2)[mask])
-                value_losses.append(value_loss.item())
-                entropy_loss = -th.mean(entropy[mask])
-                entropy_losses.append(entropy_loss.item())
-                loss = policy_loss + self.ent_coef * entropy_loss + self.vf_coef * value_loss
-                with th.no_grad():
-                    log_ratio = log_prob - data.old_log_prob
-                    approx_kl_div = th.mean(((th.exp(log_ratio) - 1) - log_ratio)[mask]).cpu().numpy()
-                    approx_kl_divs.append(approx_kl_div)
+            for data in self.rollout_buffer.get(self.update_batch_size()):
+                loss, terms = self.minibatch_loss(data, clip_range, clip_range_vf)
+                pg_losses.append(terms["policy_loss"])
+                clip_fractions.append(terms["clip_fraction"])
+                value_losses.append(terms["value_loss"])
+                entropy_losses.append(terms["entropy_loss"])
+                approx_kl_div = terms["approx_kl"]
+                approx_kl_divs.append(approx_kl_div)
                 if self.target_kl is not None and approx_kl_div > 1.5 * self.target_kl:
                     continue_training = False
                     if self.verbose >= 1:
@@ -170,6 +228,50 @@ class MaskableRecurrentPPO(RecurrentPPO):
         self.logger.record("train/clip_range", clip_range)
         if clip_range_vf is not None:
             self.logger.record("train/clip_range_vf", clip_range_vf)
+
+    def minibatch_loss(self, data, clip_range: float, clip_range_vf: float | None = None,
+                       row_mask: th.Tensor | None = None):
+        """PPO's loss on one padded minibatch, over its real steps (and ``row_mask``, if given).
+
+        Args:
+            data: a :class:`~patrolsb3.sb3.buffers.MaskableRecurrentRolloutBufferSamples`.
+            clip_range: the policy ratio clip.
+            clip_range_vf: the value clip (None: no clip).
+            row_mask: (n,) bool, further rows to leave out (tests compare the padded-slot skip
+                with the old way restricted to deployed rows).
+
+        Returns:
+            The loss tensor, and its terms as floats: policy_loss, value_loss, entropy_loss,
+            clip_fraction, approx_kl.
+        """
+        mask = data.mask > 1e-8                                                    # real (not padded) steps
+        if row_mask is not None:
+            mask = mask & row_mask
+        values, log_prob, entropy = self.policy.evaluate_actions(
+            data.observations, data.actions, data.lstm_states, data.episode_starts,
+            action_masks=data.action_masks)
+        values = values.flatten()
+        advantages = data.advantages
+        if self.normalize_advantage:
+            advantages = (advantages - advantages[mask].mean()) / (advantages[mask].std() + 1e-8)
+        ratio = th.exp(log_prob - data.old_log_prob)
+        policy_loss_1 = advantages * ratio
+        policy_loss_2 = advantages * th.clamp(ratio, 1 - clip_range, 1 + clip_range)
+        policy_loss = -th.mean(th.min(policy_loss_1, policy_loss_2)[mask])
+        if clip_range_vf is None:
+            values_pred = values
+        else:
+            values_pred = data.old_values + th.clamp(values - data.old_values, -clip_range_vf, clip_range_vf)
+        value_loss = th.mean(((data.returns - values_pred) ** 2)[mask])
+        entropy_loss = -th.mean(entropy[mask])
+        loss = policy_loss + self.ent_coef * entropy_loss + self.vf_coef * value_loss
+        with th.no_grad():
+            log_ratio = log_prob - data.old_log_prob
+            approx_kl = th.mean(((th.exp(log_ratio) - 1) - log_ratio)[mask]).item()
+            clip_fraction = th.mean((th.abs(ratio - 1) > clip_range).float()[mask]).item()
+        return loss, {"policy_loss": policy_loss.item(), "value_loss": value_loss.item(),
+                      "entropy_loss": entropy_loss.item(), "clip_fraction": clip_fraction,
+                      "approx_kl": approx_kl}
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = False, action_masks=None):
         """Actions and the next LSTM state; ``action_masks`` (n, 21) restricts the choice.

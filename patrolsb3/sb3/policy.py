@@ -280,9 +280,10 @@ class PatrolMaskablePolicy(_RoleExtractorMixin, MaskableActorCriticPolicy):
         return data
 
 
-def policy_kwargs_for(layout: dict, **overrides) -> dict:
-    """``policy_kwargs`` of our policies from a vec env's ``layout`` plus overrides."""
-    kwargs = dict(grid_shape=tuple(layout["grid_shape"]), vector_size=int(layout["vector_size"]),
-                  critic_size=int(layout["critic_size"]))
+def policy_kwargs_for(layout, **overrides) -> dict:
+    """``policy_kwargs`` of our policies from a vec env's
+    :class:`~patrolsb3.core.protocol.ObservationLayout` plus overrides."""
+    kwargs = dict(grid_shape=tuple(layout.grid_shape), vector_size=int(layout.vector_size),
+                  critic_size=int(layout.critic_size))
     kwargs.update(overrides)
     return kwargs

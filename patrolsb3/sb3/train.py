@@ -108,15 +108,32 @@ def resolve_hyperparams(map_name: str, hyperparams_file=None, overrides: dict | 
     return hp
 
 
-def algorithm_kwargs(hp: dict, spec, layout: dict, phases_per_step: int, rows: int) -> dict:
+def algorithm_kwargs(hp: dict, spec, layout, phases_per_step: int, rows: int) -> dict:
     """Constructor arguments of the SB3 algorithm from resolved hyperparameters.
 
-    ``batch_size`` is ``n_steps * rows / n_minibatches`` unless given; gamma and GAE lambda
-    are converted per env step; policy_kwargs the algorithm's policy does not take are dropped.
+    Minibatches: ``batch_size`` rows, unless ``n_minibatches`` is given: then
+    MaskableRecurrentPPO splits each rollout's deployed rows into that many minibatches, and
+    the sb3-contrib algorithms (which train on every row) use ``n_steps * rows / n_minibatches``.
+    Gamma and GAE lambda are converted per env step; policy_kwargs the algorithm's policy does
+    not take are dropped.
+
+    Raises:
+        ValueError: neither ``batch_size`` nor ``n_minibatches``, or one below 1.
     """
     from .policy import policy_kwargs_for
     n_steps = int(hp["n_steps"])
-    batch_size = hp.get("batch_size") or max(1, round(n_steps * rows / int(hp.get("n_minibatches", 1))))
+    n_minibatches = hp.get("n_minibatches")
+    batch_size = hp.get("batch_size")
+    for key, value in (("batch_size", batch_size), ("n_minibatches", n_minibatches)):
+        if value is not None and int(value) < 1:
+            raise ValueError(f"{key} must be >= 1, got {value}")
+    if n_minibatches is None and batch_size is None:
+        raise ValueError("give batch_size (rows per minibatch) or n_minibatches")
+    extra = {}
+    if n_minibatches is not None:
+        if spec.name == "MaskableRecurrentPPO":
+            extra["n_minibatches"] = int(n_minibatches)
+        batch_size = max(1, round(n_steps * rows / int(n_minibatches)))
     # keys of another policy family (e.g. the LSTM sizes for MaskablePPO) are dropped
     policy_kwargs = {k: tuple(v) if isinstance(v, list) else v for k, v in (hp.get("policy_kwargs") or {}).items()
                      if k in spec.policy_keys}
@@ -125,7 +142,7 @@ def algorithm_kwargs(hp: dict, spec, layout: dict, phases_per_step: int, rows: i
                 gae_lambda=per_phase(hp["gae_lambda"], phases_per_step), clip_range=float(hp["clip_range"]),
                 ent_coef=float(hp["ent_coef"]), vf_coef=float(hp["vf_coef"]),
                 max_grad_norm=float(hp["max_grad_norm"]), target_kl=hp.get("target_kl"),
-                policy_kwargs=policy_kwargs_for(layout, **policy_kwargs))
+                policy_kwargs=policy_kwargs_for(layout, **policy_kwargs), **extra)
 
 
 def normalized_rewards(vec_env, checkpoint: Path | None, gamma: float):
@@ -361,7 +378,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
                 raise ValueError(f"--init-from {config['init_from']['path']}: its network does not match "
                                  f"this run's (another map size, variant or policy_kwargs?): {exc}") from exc
 
-    max_agents = vec_env.layout["critic_size"] // 3
+    max_agents = vec_env.layout.max_agents
     eval_teams = [k for k in range(1, max_agents + 1) if k <= spec_map.n_vertices] * int(hp.get("eval_episodes", 1))
     eval_env_kwargs = {**env_kwargs, "episode_steps": int(hp.get("eval_episode_steps", 500))}
 

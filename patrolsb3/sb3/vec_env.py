@@ -1,14 +1,22 @@
 """Parameter sharing for SB3: every agent slot of every parallel episode is one row of an SB3
-``VecEnv``, built with SuperSuit and completed where SuperSuit 3.11 falls short of SB3.
+``VecEnv``, built with SuperSuit over one batched simulator and completed where SuperSuit 3.11
+falls short of SB3.
 
 Stack (outside in)::
 
-    PatrolVecEnv                      this module: flat Box obs, masks, seeding, episode ends
+    PatrolVecEnv                      this module: masks, seeding, team sizes, truncation flags
       SB3VecEnvWrapper                supersuit concat_vec_envs_v1(base_class="stable_baselines3")
-        ConcatVecEnv                  one MarkovVectorEnv per parallel episode
-          MarkovVectorEnv             supersuit pettingzoo_env_to_vec_env_v1: one row per slot
-            EpisodeResets             this module: team size and seed of every (auto-)reset
-              PatrolParallelEnv       the PettingZoo env
+        ConcatVecEnv                  one sub-env
+          MarkovVectorEnv             supersuit pettingzoo_env_to_vec_env_v1: one row per agent
+            BatchedPatrolEnv          patrolsb3.sb3.batched_env: the slots of all parallel
+                                      episodes as the agents of one PettingZoo ParallelEnv,
+                                      one batched simulator call per step
+
+Why this shape: SuperSuit stays the flattening layer (a PettingZoo env in, a shared-policy
+vector env out), but the simulator underneath steps every parallel episode in one call: 8
+one-episode envs cost 8 calls and 8 sets of observations per step, one batched env costs
+about one. The agent protocol (phases, masks, flat layout) is :mod:`patrolsb3.core.protocol`,
+the same as in the PettingZoo env and the zoo policy.
 
 Gaps of SuperSuit closed here:
 
@@ -17,11 +25,14 @@ Gaps of SuperSuit closed here:
   masks sb3-contrib's ``get_action_masks`` needs).
 * SuperSuit's SB3 wrapper joins termination and truncation into ``dones``; we read both from
   the gymnasium-level ``ConcatVecEnv`` and set ``TimeLimit.truncated`` so SB3 bootstraps the
-  value at the horizon. ``terminal_observation`` is flattened like the observations.
-* ``black_death_v3`` is not used: slots never leave the env (inactive slots have the single
-  legal action (0, Stay) and reward 0), and it rejects Dict observations.
-* Unseeded auto-resets would draw fresh entropy; :class:`EpisodeResets` draws each episode's
-  seed from a generator seeded at the seeded reset, so a seeded run is reproducible.
+  value at the horizon.
+* ``black_death_v3`` is not used: slots never leave the env (inactive and padded slots have
+  the single legal action (0, Stay) and reward 0).
+
+Padded slots (a team smaller than ``max_agents``) keep their rows, since SB3 fixes
+``num_envs``; :meth:`PatrolVecEnv.deployed_rows` says which rows act, so that
+:class:`~patrolsb3.sb3.maskable_recurrent_ppo.MaskableRecurrentPPO` neither runs the policy
+on the others nor trains on them.
 
 Discount with two phases: with same-step messages (comm 'learned' or 'intention') one
 simulator step is two env steps (message phase, then move phase), and the message phase's
@@ -35,12 +46,13 @@ from typing import Any, Sequence
 
 import numpy as np
 import supersuit as ss
-from gymnasium import spaces
-from pettingzoo.utils.wrappers import BaseParallelWrapper
 from stable_baselines3.common.vec_env import VecEnvWrapper
 from stable_baselines3.common.vec_env.base_vec_env import VecEnvIndices
 
-from ..env import PatrolParallelEnv
+from ..core import protocol
+from ..core.config import EnvConfig, make_config
+from ..core.maps import load_map
+from .batched_env import BatchedPatrolEnv
 from .variants import variant_overrides
 
 DEFAULT_AGENTS = (1, 1, 1, 1, 2, 3, 4, 5)
@@ -50,112 +62,53 @@ MASK_METHOD = "action_masks"
 """Name sb3-contrib's ``get_action_masks`` / ``is_masking_supported`` look for."""
 
 
-class EpisodeResets(BaseParallelWrapper):
-    """Gives every reset of the wrapped env a team size and, once seeded, a seed.
-
-    SuperSuit's vector envs auto-reset without seed or options; this wrapper supplies both:
-    ``n_agents`` (changed by :meth:`PatrolVecEnv.set_agents`, effective at the next reset) and a
-    seed drawn from a generator seeded by the last seeded reset.
-    """
-
-    def __init__(self, env: PatrolParallelEnv, n_agents: int):
-        super().__init__(env)
-        self.n_agents = int(n_agents)
-        self._seed_rng = None  # np.random.Generator, set by a seeded reset
-
-    def reset(self, seed=None, options=None):
-        """Reset with ``options["n_agents"]`` defaulting to ``self.n_agents``."""
-        if seed is not None:
-            self._seed_rng = np.random.default_rng(seed)
-        elif self._seed_rng is not None:
-            seed = int(self._seed_rng.integers(2 ** 31 - 1))
-        options = dict(options or {})
-        options.setdefault("n_agents", self.n_agents)
-        return self.env.reset(seed=seed, options=options)
-
-
-def flatten_observation(obs: dict) -> np.ndarray:
-    """Flatten Dict observations to the vector layout [grid, vector, critic].
-
-    Args:
-        obs: {"grid": (..., 2, H, W), "vector": (..., 15), "critic": (..., 3 * max_agents)},
-            with any number of leading batch axes (none for one agent's observation).
-
-    Returns:
-        (..., 2*H*W + 15 + 3*max_agents) float32.
-    """
-    batch = obs["vector"].shape[:-1]
-    return np.concatenate([obs["grid"].reshape(*batch, -1), obs["vector"], obs["critic"]],
-                          axis=-1).astype(np.float32)
-
-
-def mask_row(action_mask: tuple) -> np.ndarray:
-    """One slot's (message (n_symbols,), move (5,)) int8 masks as a (n_symbols + 5,) bool row."""
-    return np.concatenate(action_mask).astype(bool)
-
-
 class PatrolVecEnv(VecEnvWrapper):
     """SB3 ``VecEnv`` with one row per agent slot of every parallel episode.
 
     Row ``k`` is slot ``k % max_agents`` of episode ``k // max_agents``; one shared policy
     acts for all rows (parameter sharing).
 
-    Observation: Box(-1, 1, (2*H*W + 15 + 3*max_agents,), float32), the env's Dict observation
-    flattened as [grid (2, H, W) in C order, vector (15), critic (3*max_agents)]; see
-    :attr:`layout`. The critic part is the centralised state; actors must not read it.
+    Observation: Box(-1, 1, (layout.size,), float32) in the flat layout of
+    :class:`patrolsb3.core.protocol.ObservationLayout` ([grid (2, H, W) in C order, vector,
+    critic (3 * max_agents)]); the critic part is the centralised state; actors must not read it.
 
     Action: MultiDiscrete([n_symbols, 5]) = (message, move). :meth:`action_masks` gives
-    (num_envs, n_symbols + 5) bool, message mask then move mask, from the env's infos.
+    (num_envs, n_symbols + 5) bool, message mask then move mask.
 
     Infos at an episode's last step (every row of it): ``terminal_observation`` (flat),
     ``TimeLimit.truncated`` (cut by the horizon, not terminated), ``episode`` ({"r": the
-    slot's return, "l": env steps}) and ``team_episode`` (see :meth:`_team_summary`).
+    slot's return, "l": env steps}) and ``team_episode`` (the team's summary: reward,
+    n_agents, mean_idleness, max_idleness, collisions, battery_failures, sim_steps).
 
     Attributes:
-        layout: {"grid_shape": (2, H, W), "vector_size": 15, "critic_size": 3 * max_agents}.
+        layout: the :class:`~patrolsb3.core.protocol.ObservationLayout` of the rows.
         phases_per_step: env steps per simulator step (2 with same-step messages, else 1);
             discount per env step = gamma ** (1 / phases_per_step), gamma per simulator step.
         max_agents: slots per parallel episode.
         n_episodes: parallel episodes (``num_envs // max_agents``).
+        episodes: the :class:`~patrolsb3.sb3.batched_env.BatchedPatrolEnv` underneath.
     """
 
     def __init__(self, venv):
         """Wrap SuperSuit's SB3 vector env (from ``concat_vec_envs_v1``).
 
         Args:
-            venv: ``SB3VecEnvWrapper`` over a ``ConcatVecEnv`` of ``MarkovVectorEnv`` over
-                :class:`EpisodeResets`.
+            venv: ``SB3VecEnvWrapper`` over a ``ConcatVecEnv`` of one ``MarkovVectorEnv`` over
+                a :class:`~patrolsb3.sb3.batched_env.BatchedPatrolEnv`.
         """
         self._concat = venv.venv                                     # ConcatVecEnv
-        self._resets = [v.par_env for v in self._concat.vec_envs]    # EpisodeResets per episode
-        env = self._resets[0].unwrapped
-        self.max_agents = env.cfg.max_agents
-        self.n_episodes = len(self._resets)
-        H, W = env.spec_map.shape
-        self.layout = {"grid_shape": (2, H, W), "vector_size": venv.observation_space["vector"].shape[0],
-                       "critic_size": venv.observation_space["critic"].shape[0]}
-        size = 2 * H * W + self.layout["vector_size"] + self.layout["critic_size"]
-        observation_space = spaces.Box(-1.0, 1.0, (size,), np.float32)
-        super().__init__(venv, observation_space=observation_space, action_space=venv.action_space)
-        # discount: same-step messages make two env steps per simulator step (module docstring)
-        self.phases_per_step = 2 if env._two_phase else 1
-        n_mask = int(np.sum(self.action_space.nvec))
-        N, E = self.num_envs, self.n_episodes
-        self._masks = np.zeros((N, n_mask), dtype=bool)   # (N, n_symbols + 5) from the last infos
+        self.episodes = self._concat.vec_envs[0].par_env             # BatchedPatrolEnv
+        self.layout = self.episodes.layout
+        self.max_agents = self.episodes.max_agents
+        self.n_episodes = self.episodes.n_episodes
+        super().__init__(venv, observation_space=venv.observation_space, action_space=venv.action_space)
+        self.phases_per_step = protocol.phases_per_step(self.episodes.cfg)
         self._pending_seed = None
-        self._returns = np.zeros(N, dtype=np.float64)     # (N,) return of each row's episode so far
-        self._lengths = np.zeros(N, dtype=np.int64)       # (N,) env steps of each row's episode
-        self._team = np.array([r.n_agents for r in self._resets], dtype=np.int64)  # (E,) deployed
-        self._sim_steps = np.zeros(E, dtype=np.int64)     # (E,) simulator steps so far
-        self._idle_sum = np.zeros(E, dtype=np.float64)    # (E,) sum over sim steps of mean idleness
-        self._idle_max = np.zeros(E, dtype=np.float64)    # (E,) worst instantaneous max idleness
-        self._collisions = np.zeros(E, dtype=np.int64)    # (E,) collision events
-        self._failures = np.zeros(E, dtype=np.int64)      # (E,) battery failures
 
     # ------------------------------------------------------------------ episodes of the rows
-    def get_env(self, i: int) -> PatrolParallelEnv:
-        """The PettingZoo env of parallel episode ``i`` (rows i*max_agents .. +max_agents-1)."""
-        return self._resets[i].unwrapped
+    def episode_config(self, i: int) -> EnvConfig:
+        """The settings of parallel episode ``i`` (rows i*max_agents .. +max_agents-1)."""
+        return self.episodes.configs[i]
 
     def set_agents(self, agents: Sequence[int]) -> None:
         """Team size of each parallel episode, effective from its next reset.
@@ -167,71 +120,47 @@ class PatrolVecEnv(VecEnvWrapper):
             ValueError: wrong length, or a team size the env refuses (below 1, above
                 max_agents or above the map's vertex count).
         """
-        agents = [int(k) for k in agents]
-        if len(agents) != self.n_episodes:
-            raise ValueError(f"set_agents needs {self.n_episodes} team sizes (one per parallel "
-                             f"episode), got {len(agents)}: {agents}")
-        for i, k in enumerate(agents):
-            self.get_env(i)._check_team(k)  # the env's own rule for a valid team
-        for resets, k in zip(self._resets, agents):
-            resets.n_agents = k
+        self.episodes.set_teams(agents)
 
     def get_agents(self) -> list[int]:
         """Team sizes scheduled for the parallel episodes (used from their next reset)."""
-        return [r.n_agents for r in self._resets]
+        return [int(k) for k in self.episodes.teams]
+
+    def running_agents(self) -> list[int]:
+        """Team sizes of the running episodes."""
+        return [int(k) for k in self.episodes.running]
+
+    def deployed_rows(self) -> np.ndarray:
+        """(num_envs,) bool: rows of deployed slots (the others are padding and never act)."""
+        return self.episodes.deployed_rows()
 
     def action_masks(self) -> np.ndarray:
-        """(num_envs, n_symbols + 5) bool: message mask then move mask of every row, from the
-        infos of the last reset or step."""
-        return self._masks.copy()
+        """(num_envs, n_symbols + 5) bool: message mask then move mask of every row, for the
+        current phase."""
+        return self.episodes.masks.copy()
 
     # ------------------------------------------------------------------ VecEnv API
     def seed(self, seed: int | None = None) -> list[int | None]:
-        """Seed the next reset: episode ``i`` gets ``seed + i``, its later episodes seeds drawn
-        from a generator seeded with it. Returns the seed of each row."""
+        """Seed the next reset (the generator every parallel episode draws from)."""
         self._pending_seed = None if seed is None else int(seed)
-        if seed is None:
-            return [None] * self.num_envs
-        return [int(seed) + k // self.max_agents for k in range(self.num_envs)]
+        return [self._pending_seed] * self.num_envs
 
     def reset(self) -> np.ndarray:
         """Reset every parallel episode; (num_envs, obs_size) float32."""
         obs, infos = self._concat.reset(seed=self._pending_seed)
         self._pending_seed = None
-        self._returns[:] = 0.0
-        self._lengths[:] = 0
-        for e in range(self.n_episodes):
-            self._start_episode(e)
         self.reset_infos = infos
-        self._update_masks(infos)
-        return flatten_observation(obs)
+        return obs
 
     def step_wait(self):
-        """Step every row; SB3's (obs, rewards, dones, infos) with episode-end infos added."""
+        """Step every row; SB3's (obs, rewards, dones, infos)."""
         obs, rewards, terminations, truncations, infos = self._concat.step_wait()
         terminations = np.asarray(terminations, dtype=bool)   # (N,)
         truncations = np.asarray(truncations, dtype=bool)     # (N,)
         dones = terminations | truncations                    # (N,)
-        self._returns += rewards
-        self._lengths += 1
-        A = self.max_agents
-        for e in range(self.n_episodes):
-            rows = range(e * A, (e + 1) * A)
-            self._accumulate(e, [infos[k] for k in rows])
-            if not dones[e * A]:
-                continue
-            summary = self._team_summary(e)
-            for k in rows:
-                info = infos[k]
-                info["terminal_observation"] = flatten_observation(info["terminal_observation"])
-                info["TimeLimit.truncated"] = bool(truncations[k] and not terminations[k])
-                info["episode"] = {"r": float(self._returns[k]), "l": int(self._lengths[k])}
-                info["team_episode"] = dict(summary)
-                self._returns[k] = 0.0
-                self._lengths[k] = 0
-            self._start_episode(e)
-        self._update_masks(infos)
-        return flatten_observation(obs), np.asarray(rewards, dtype=np.float32), dones, infos
+        for k in np.flatnonzero(dones):
+            infos[k]["TimeLimit.truncated"] = bool(truncations[k] and not terminations[k])
+        return obs, np.asarray(rewards, dtype=np.float32), dones, infos
 
     def set_options(self, options=None) -> None:
         """Reset options are not forwarded by SuperSuit; team sizes go through set_agents.
@@ -244,77 +173,36 @@ class PatrolVecEnv(VecEnvWrapper):
                                       f"team sizes with set_agents([...]) and seeds with seed(s)")
 
     def has_attr(self, attr_name: str) -> bool:
-        """True for ``action_masks`` and for attributes of the PettingZoo env."""
-        return attr_name == MASK_METHOD or hasattr(self.get_env(0), attr_name)
+        """True for ``action_masks`` and for attributes of the batched env."""
+        return attr_name == MASK_METHOD or hasattr(self.episodes, attr_name)
 
     def get_attr(self, attr_name: str, indices: VecEnvIndices = None) -> list[Any]:
-        """Attribute of the PettingZoo env of each row's episode."""
-        return [getattr(self.get_env(k // self.max_agents), attr_name)
-                for k in self._get_indices(indices)]
+        """Per row: ``n_agents`` (its episode's running team), ``cfg`` (its episode's settings),
+        else the batched env's attribute."""
+        rows = list(self._get_indices(indices))
+        if attr_name == "n_agents":
+            return [int(self.episodes.running[k // self.max_agents]) for k in rows]
+        if attr_name == "cfg":
+            return [self.episode_config(k // self.max_agents) for k in rows]
+        return [getattr(self.episodes, attr_name) for _ in rows]
 
     def set_attr(self, attr_name: str, value: Any, indices: VecEnvIndices = None) -> None:
-        """Set an attribute on the PettingZoo env of each given row's episode."""
-        for e in sorted({k // self.max_agents for k in self._get_indices(indices)}):
-            setattr(self.get_env(e), attr_name, value)
+        """Set an attribute of the batched env (shared by every row)."""
+        setattr(self.episodes, attr_name, value)
 
     def env_method(self, method_name: str, *method_args, indices: VecEnvIndices = None,
                    **method_kwargs) -> list[Any]:
         """``action_masks``: each row's (n_symbols + 5,) bool mask; any other name is called on
-        the PettingZoo env of each row's episode."""
+        the batched env, once per row asked."""
         rows = list(self._get_indices(indices))
         if method_name == MASK_METHOD:
-            return [self._masks[k].copy() for k in rows]
-        return [getattr(self.get_env(k // self.max_agents), method_name)(*method_args, **method_kwargs)
-                for k in rows]
+            masks = self.episodes.masks
+            return [masks[k].copy() for k in rows]
+        return [getattr(self.episodes, method_name)(*method_args, **method_kwargs) for _ in rows]
 
     def env_is_wrapped(self, wrapper_class, indices: VecEnvIndices = None) -> list[bool]:
-        """No row is wrapped by a gymnasium wrapper (PettingZoo envs underneath)."""
+        """No row is wrapped by a gymnasium wrapper (a PettingZoo env underneath)."""
         return [False for _ in self._get_indices(indices)]
-
-    # ------------------------------------------------------------------ bookkeeping
-    def _update_masks(self, infos: list[dict]) -> None:
-        for k, info in enumerate(infos):
-            self._masks[k] = mask_row(info["action_mask"])
-
-    def _start_episode(self, e: int) -> None:
-        """Zero episode ``e``'s accumulators and record its team (the one it was reset with)."""
-        self._team[e] = self.get_env(e).n_agents
-        self._sim_steps[e] = 0
-        self._idle_sum[e] = 0.0
-        self._idle_max[e] = 0.0
-        self._collisions[e] = 0
-        self._failures[e] = 0
-
-    def _accumulate(self, e: int, infos: list[dict]) -> None:
-        """Add one env step of episode ``e`` (its max_agents row infos) to the accumulators."""
-        if "mean_idleness" not in infos[0]:  # a message phase: the simulator did not step
-            return
-        self._sim_steps[e] += 1
-        self._idle_sum[e] += infos[0]["mean_idleness"]
-        self._idle_max[e] = max(self._idle_max[e], infos[0]["max_idleness"])
-        self._collisions[e] += infos[0]["collisions"]
-        self._failures[e] += sum(int(i["battery_failed"]) for i in infos)
-
-    def _team_summary(self, e: int) -> dict:
-        """Episode ``e``'s summary for the learning curve.
-
-        Returns:
-            reward: mean over deployed slots of their return; n_agents: team size;
-            mean_idleness: time average of the mean vertex idleness (AVG^h); max_idleness:
-            worst instantaneous vertex idleness; collisions: events; battery_failures: slots
-            whose battery ran out; sim_steps: simulator steps.
-        """
-        A, n = self.max_agents, int(self._team[e])
-        steps = int(self._sim_steps[e])
-        return {
-            "reward": float(self._returns[e * A:e * A + n].mean()),
-            "n_agents": n,
-            "mean_idleness": float(self._idle_sum[e] / max(steps, 1)),
-            "max_idleness": float(self._idle_max[e]),
-            "collisions": int(self._collisions[e]),
-            "battery_failures": int(self._failures[e]),
-            "sim_steps": steps,
-        }
 
 
 def make_vec_env(map="A", agents: Sequence[int] = DEFAULT_AGENTS, variant: str = "rl-msg",
@@ -326,20 +214,21 @@ def make_vec_env(map="A", agents: Sequence[int] = DEFAULT_AGENTS, variant: str =
         map: shipped map name ("A" .. "D"), a map file path or a MapSpec.
         agents: team size of each parallel episode; ``num_envs = len(agents) * max_agents``.
         variant: a key of :data:`patrolsb3.sb3.VARIANTS` (sets the env's ``comm``).
-        seed: seed of the first reset (episode i gets seed + i); None for fresh entropy.
+        seed: seed of the first reset; None for fresh entropy.
         strict: True: a masked action raises in the env; False: masked moves act as Stay
             (``invalid_action="stay"``), for algorithms without masks.
         episode_env: {parallel episode index: EnvConfig overrides} for episodes that run with
-            other settings than ``env_kwargs`` (only settings that keep the spaces, see
-            :meth:`PatrolParallelEnv.reconfigure`), e.g. short low-battery episodes beside
-            long ones.
+            other settings than ``env_kwargs`` (only settings that keep the spaces and phases,
+            see :func:`patrolsb3.core.protocol.protocol_signature`), e.g. short low-battery
+            episodes beside long ones.
         **env_kwargs: other EnvConfig fields (``episode_steps``, ``message_timing``, ...).
 
     Returns:
         A :class:`PatrolVecEnv`, seeded but not yet reset.
 
     Raises:
-        ValueError: unknown variant, empty ``agents``, or a team size the env refuses.
+        ValueError: unknown variant, empty ``agents``, a team size the env refuses, or an
+            ``episode_env`` entry for an episode the run does not have or that changes the spaces.
         TypeError: ``comm`` / ``invalid_action`` given directly (use ``variant`` / ``strict``),
             or an unknown EnvConfig field.
     """
@@ -349,18 +238,22 @@ def make_vec_env(map="A", agents: Sequence[int] = DEFAULT_AGENTS, variant: str =
     agents = [int(k) for k in agents]
     if not agents:
         raise ValueError("agents must list at least one team size (one per parallel episode)")
-    config = {**variant_overrides(variant), **env_kwargs,
-              "invalid_action": "raise" if strict else "stay"}
-    template = PatrolParallelEnv(map=map, n_agents=agents[0], **config)
-    for k in agents:
-        template._check_team(k)  # the env's own rule for a valid team
-    markov = ss.pettingzoo_env_to_vec_env_v1(EpisodeResets(template, agents[0]))
-    venv = ss.concat_vec_envs_v1(markov, len(agents), num_cpus=0, base_class="stable_baselines3")
-    vec_env = PatrolVecEnv(venv)
+    spec = load_map(map)
+    config = {**variant_overrides(variant), **env_kwargs, "invalid_action": "raise" if strict else "stay"}
+    base = make_config(spec.name, **config)
+    configs = [base] * len(agents)
     for i, overrides in (episode_env or {}).items():
         if not 0 <= int(i) < len(agents):
             raise ValueError(f"episode_env: no parallel episode {i} (there are {len(agents)})")
-        vec_env.get_env(int(i)).reconfigure(**overrides)
-    vec_env.set_agents(agents)
+        cfg = make_config(None, **{**base.to_dict(), **overrides})
+        if protocol.protocol_signature(cfg) != protocol.protocol_signature(base):
+            changed = [k for k in overrides if getattr(cfg, k) != getattr(base, k)]
+            raise ValueError(f"episode_env: {', '.join(changed)} would change the spaces or phases "
+                             f"of the env; only settings that keep them can differ per episode")
+        configs[int(i)] = cfg
+    batched = BatchedPatrolEnv(spec, configs, agents)
+    markov = ss.pettingzoo_env_to_vec_env_v1(batched)
+    venv = ss.concat_vec_envs_v1(markov, 1, num_cpus=0, base_class="stable_baselines3")
+    vec_env = PatrolVecEnv(venv)
     vec_env.seed(seed)
     return vec_env
