@@ -74,3 +74,38 @@ def test_single_legal_action_has_log_prob_zero_and_no_entropy():
                                                  action_masks=masks)
     assert actions.tolist() == [[0, 4]] * 4
     assert th.all(log_prob == 0) and th.all(lp == 0) and th.all(entropy.abs() < 1e-6)
+
+
+def test_masked_sample_is_sb3_contribs_masked_distribution():
+    from gymnasium import spaces
+    from sb3_contrib.common.maskable.distributions import make_masked_proba_distribution
+
+    from patrolsb3.sb3.policy import masked_sample
+    space = spaces.MultiDiscrete([16, 5])
+    gen = th.Generator().manual_seed(0)
+    logits = th.randn(64, 21, generator=gen)
+    masks = th.rand(64, 21, generator=gen) > 0.5
+    masks[:, 0] = masks[:, 16 + 4] = True                   # one legal value per dimension at least
+    dist = make_masked_proba_distribution(space).proba_distribution(action_logits=logits)
+    dist.apply_masking(masks)
+    actions, log_prob = masked_sample(logits, masks, space.nvec, deterministic=True)
+    th.testing.assert_close(actions, dist.get_actions(deterministic=True).reshape(-1, 2))
+    th.testing.assert_close(log_prob, dist.log_prob(actions), rtol=1e-5, atol=1e-5)
+    th.manual_seed(1)
+    sampled, log_prob = masked_sample(logits, masks, space.nvec)
+    assert masks[th.arange(64), sampled[:, 0]].all() and masks[th.arange(64), 16 + sampled[:, 1]].all()
+    th.testing.assert_close(log_prob, dist.log_prob(sampled), rtol=1e-5, atol=1e-5)
+
+
+def test_lstm_step_is_one_step_of_the_lstm():
+    from torch import nn
+
+    from patrolsb3.sb3.policy import lstm_step
+    lstm = nn.LSTM(7, 5)
+    gen = th.Generator().manual_seed(0)
+    x, h, c = th.randn(3, 7, generator=gen), th.randn(1, 3, 5, generator=gen), th.randn(1, 3, 5, generator=gen)
+    out, (h1, c1) = lstm_step(x, (h, c), lstm)
+    ref, (h2, c2) = lstm(x[None], (h, c))
+    th.testing.assert_close(out, ref[0])
+    th.testing.assert_close(h1, h2)
+    th.testing.assert_close(c1, c2)

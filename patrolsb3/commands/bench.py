@@ -10,9 +10,23 @@ def add_arguments(parser):
     parser.add_argument("target", choices=sorted(TARGETS), help="what to measure")
     parser.add_argument("--repeats", type=int, default=5, help="repeats; the median is printed")
     parser.add_argument("--quick", action="store_true", help="smaller sizes (smoke test)")
+    parser.add_argument("--device", default="cpu", choices=["auto", "cpu", "cuda"],
+                        help="torch device of 'bench train' (default cpu; auto = cuda when torch sees one)")
+    parser.add_argument("--set", nargs="+", action="extend", default=[], metavar="KEY=VALUE",
+                        help="'bench train': hyperparameter overrides, e.g. batch_size=512")
 
 
 def run(args):
     module = importlib.import_module(TARGETS[args.target])
-    print(json.dumps(module.run(repeats=args.repeats, quick=args.quick)))
+    if args.target == "train":
+        from ..sb3.algorithms import torch_device
+        from ..sb3.hyperparams import parse_set
+        torch_device(args.device)   # a device torch cannot use: one line, before any work
+        result = module.run(repeats=args.repeats, quick=args.quick, device=args.device,
+                            overrides=parse_set(args.set))
+    elif args.set or args.device != "cpu":
+        raise ValueError(f"--set and --device are options of 'bench train', not 'bench {args.target}'")
+    else:
+        result = module.run(repeats=args.repeats, quick=args.quick)
+    print(json.dumps(result))
     return 0

@@ -55,3 +55,23 @@ def get_algorithm(name: str) -> AlgorithmSpec:
     if name not in ALGORITHMS:
         raise ValueError(f"unknown algorithm {name!r}; known algorithms: {sorted(ALGORITHMS)}")
     return ALGORITHMS[name]
+
+
+DEVICES = ("auto", "cpu", "cuda")
+"""What ``--device`` takes: auto = cuda when torch sees a GPU, else cpu."""
+
+
+def torch_device(name: str) -> str:
+    """The torch device a ``--device`` value means.
+
+    Raises:
+        ValueError: a value not in :data:`DEVICES`, or "cuda" where torch sees no GPU.
+    """
+    if name not in DEVICES:
+        raise ValueError(f"--device must be one of {', '.join(DEVICES)}, got {name!r}")
+    import torch
+    if name == "auto":
+        return "cuda" if torch.cuda.is_available() else "cpu"
+    if name == "cuda" and not torch.cuda.is_available():
+        raise ValueError("--device cuda: torch sees no CUDA device here (use --device cpu or auto)")
+    return name
