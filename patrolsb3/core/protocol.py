@@ -217,8 +217,8 @@ def check_actions(cfg: EnvConfig, phase: int, actions: np.ndarray, masks: np.nda
     n = cfg.n_symbols
     message, move = actions[..., 0], actions[..., 1]
     in_range = (message >= 0) & (message < n)
-    message_ok = in_range & np.take_along_axis(masks[..., :n], np.clip(message, 0, n - 1)[..., None],
-                                               axis=-1)[..., 0]
+    E, A = message.shape
+    message_ok = in_range & masks[np.arange(E)[:, None], np.arange(A), np.where(in_range, message, 0)]
     ok = message_ok & (move == STAY) if phase == MESSAGE_PHASE else message_ok
     if ok.all():
         return actions

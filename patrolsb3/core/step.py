@@ -97,6 +97,19 @@ def check_moves(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray) 
     return moves
 
 
+def _no_conflict(spec: MapSpec, pos: np.ndarray, target: np.ndarray, active: np.ndarray,
+                 moving: np.ndarray, on_station: np.ndarray) -> bool:
+    """True when no rule of :func:`resolve_collisions` can apply: off the stations, no cell is
+    both held or entered twice (positions of active agents and targets of movers, together).
+    Then there is no swap, no contested cell and no blocked mover, and every mover arrives."""
+    cells = spec.kinds.size
+    row = np.arange(pos.shape[0])[:, None] * cells                       # (E, 1)
+    held = row + pos
+    entered = row + target
+    keys = np.sort(np.concatenate([held[active & ~station_cells(spec)[pos]], entered[moving & ~on_station]]))
+    return bool((keys[1:] != keys[:-1]).all())
+
+
 def resolve_collisions(spec: MapSpec, pos: np.ndarray, target: np.ndarray, active: np.ndarray,
                        rng: np.random.Generator):
     """Apply the collision rule to simultaneous moves.
@@ -113,6 +126,8 @@ def resolve_collisions(spec: MapSpec, pos: np.ndarray, target: np.ndarray, activ
     E, A = pos.shape
     on_station = station_cells(spec)[target]                              # (E, A)
     moving = active & (target != pos)
+    if _no_conflict(spec, pos, target, active, moving, on_station):
+        return np.where(moving, target, pos), np.zeros((E, A), dtype=bool), np.zeros(E, dtype=np.int64)
     # swap conflicts: i -> pos_j and j -> pos_i
     swap = (moving[:, :, None] & moving[:, None, :]
             & (target[:, :, None] == pos[:, None, :]) & (target[:, None, :] == pos[:, :, None]))
@@ -190,12 +205,13 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
     state.idle += spec.rate
     v_at = spec.vertex_of_cell[new_pos]                                    # (E, A) -1 off-vertex
     on_vertex = acted & (v_at >= 0)
-    e_idx = np.broadcast_to(np.arange(E)[:, None], (E, A))
     v_safe = np.maximum(v_at, 0)
-    idle_without_k = state.idle[e_idx, v_safe]                           # (E, A)
-    visited_without_k = state.visited[e_idx, v_safe]
-    state.idle[e_idx[on_vertex], v_at[on_vertex]] = 0.0
-    state.visited[e_idx[on_vertex], v_at[on_vertex]] = True
+    e_col = np.arange(E)[:, None]                                          # (E, 1)
+    idle_without_k = state.idle[e_col, v_safe]                             # (E, A)
+    visited_without_k = state.visited[e_col, v_safe]
+    e_on, a_on = np.nonzero(on_vertex)
+    state.idle[e_on, v_at[e_on, a_on]] = 0.0
+    state.visited[e_on, v_at[e_on, a_on]] = True
     state.pos = new_pos
     # 7. hot swaps: running swaps count down, then new arrivals on purpose start one
     swapping = state.status == SWAPPING
