@@ -61,8 +61,9 @@ def canonical_name(name: str) -> str:
     return name.upper()
 
 
-def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0):
-    """A heuristic by name, or ``zoo:<variant>`` through ``patrolsb3.zoo.load(map, variant)``.
+def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0, device: str = "cpu"):
+    """A heuristic by name, or ``zoo:<variant>`` through ``patrolsb3.zoo.load(map, variant)``
+    (its network on ``device``: auto, cpu or cuda).
 
     Raises:
         ValueError: unknown strategy, or a zoo strategy when no zoo module or model exists.
@@ -74,7 +75,7 @@ def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0):
         except ImportError as exc:
             raise ValueError(f"strategy {name!r} needs patrolsb3.zoo, which cannot be imported: {exc}") from exc
         try:
-            return zoo.load(spec.name, variant, spec=spec)
+            return zoo.load(spec.name, variant, spec=spec, device=device)
         except (ValueError, FileNotFoundError) as exc:
             raise ValueError(f"strategy {name!r}: {exc}") from exc
     from . import strategies
@@ -170,7 +171,7 @@ def summarize(per_episode: dict, tests: int) -> dict:
 
 def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100, tests: int = 1,
              steps: int = 14400, seed: int = 0, faults=(), progress: bool = True, deterministic: bool = True,
-             **env) -> dict:
+             device: str = "cpu", **env) -> dict:
     """Evaluate one strategy on one map and team size (the ``patrolsb3 evaluate`` command).
 
     Args:
@@ -185,6 +186,8 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
         progress: show a progress bar.
         deterministic: a zoo model takes its most likely legal action (True, SB3's evaluation
             default) or samples from its policy (False); heuristics are unaffected.
+        device: where a zoo model's network runs: auto (cuda when torch sees one), cpu
+            (default: the figures of the zoo's eval.json were computed there) or cuda.
         **env: other EnvConfig fields (e.g. p_dyn_max=0).
 
     Returns:
@@ -192,7 +195,7 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
         ``bounds`` (:func:`idleness_lower_bounds`).
     """
     spec, cfg = evaluation_setup(map_name, n_agents, episodes, tests, steps, faults, **env)
-    policy = load_policy(strategy, spec, n_agents, cfg, seed=seed)
+    policy = load_policy(strategy, spec, n_agents, cfg, seed=seed, device=device)
     policy_cfg = getattr(policy, "cfg", None)
     if policy_cfg is not None and policy_cfg.max_agents != cfg.max_agents:
         cfg = make_config(None, **{**cfg.to_dict(), "max_agents": policy_cfg.max_agents})

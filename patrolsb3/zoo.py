@@ -188,7 +188,7 @@ def load_checkpoint(path, spec=None) -> ZooPolicy:
     return ZooPolicy(model.policy, spec, env_config(config), info)
 
 
-def load(map_name: str, variant: str, zoo_dir=None, spec=None) -> ZooPolicy:
+def load(map_name: str, variant: str, zoo_dir=None, spec=None, device: str = "cpu") -> ZooPolicy:
     """Load a zoo model ready to act: ``patrolsb3.zoo.load("A", "rl-msg")``.
 
     Args:
@@ -196,10 +196,12 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None) -> ZooPolicy:
         variant: "rl-msg", "rl-no-msg" or "rl-intention".
         zoo_dir: another zoo folder (default: the repository's ``zoo/``).
         spec: the map to act on (default: ``map_name``); must match the training map's size.
+        device: where the network runs: "cpu" (default), "cuda" or "auto".
 
     Raises:
         ZooError: no such entry (lists what the zoo has), or a checkpoint trained for another
             env version or map size.
+        ValueError: a device torch cannot use.
     """
     if variant not in VARIANT_NAMES:
         raise ZooError(f"unknown variant {variant!r}; known: {', '.join(VARIANT_NAMES)}")
@@ -218,10 +220,10 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None) -> ZooPolicy:
     cfg = env_config(config)
     import torch
     torch.set_num_threads(1)     # small networks: one thread is fastest, and several oversubscribe
-    from .sb3.algorithms import get_algorithm
+    from .sb3.algorithms import get_algorithm, torch_device
     _, policy_class = get_algorithm(config.get("algo", "MaskableRecurrentPPO")).classes()
     try:
-        policy = policy_class.load(str(folder / "model.zip"), device="cpu")
+        policy = policy_class.load(str(folder / "model.zip"), device=torch_device(device))
     except Exception as exc:  # a corrupt or foreign file: say which one
         raise ZooError(f"{folder / 'model.zip'}: cannot be loaded as a {policy_class.__name__} "
                        f"({type(exc).__name__}: {exc})") from exc

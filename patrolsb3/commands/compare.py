@@ -41,6 +41,8 @@ def add_arguments(parser):
     parser.add_argument("--rerun", action="store_true",
                         help="evaluate the heuristics again even when OUT/results.json already holds "
                              "a result of this exact protocol (a rerun or an interrupted run reuses them)")
+    parser.add_argument("--device", default="cpu", choices=["auto", "cpu", "cuda"],
+                        help="where zoo models' networks run (default cpu; auto = cuda when torch sees one)")
     parser.add_argument("--rerun-zoo", action="store_true",
                         help="evaluate zoo models again even when their eval.json already holds this "
                              "exact protocol (episodes, steps, seed, tests, action mode)")
@@ -52,6 +54,8 @@ def run(args):
     from ..evaluate import evaluate, evaluation_setup, request_of
     from ..report import EXTRA_COLUMNS, ZOO_COLUMNS, clean_figures, write_compare
     from ..result_store import ResultStore
+    from ..sb3.algorithms import torch_device
+    torch_device(args.device)   # a device torch cannot use: one line, before any work
     if args.protocol == "paper":
         args.tests, args.episodes, args.steps = 10, 100, 14400
     maps = [m.strip() for m in args.maps.split(",") if m.strip()]
@@ -99,7 +103,7 @@ def run(args):
                 if r is None:
                     r = evaluate(name, m, n, episodes=args.episodes, tests=args.tests, steps=args.steps,
                                  seed=args.seed, progress=not args.no_progress,
-                                 deterministic=not args.stochastic)
+                                 deterministic=not args.stochastic, device=args.device)
                     if not name.startswith("zoo:"):
                         store.add(r)
                 s = r["summary"]

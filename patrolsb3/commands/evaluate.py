@@ -15,6 +15,8 @@ def add_arguments(parser):
                         help="K agents fail for good at STEP (repeatable); AVG/MAX are split at each")
     parser.add_argument("--stochastic", action="store_true",
                         help="a zoo model samples its actions instead of taking the most likely one")
+    parser.add_argument("--device", default="cpu", choices=["auto", "cpu", "cuda"],
+                        help="where a zoo model's network runs (default cpu; auto = cuda when torch sees one)")
     parser.add_argument("--json", default=None, metavar="FILE", help="also write the result as JSON")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
 
@@ -22,9 +24,11 @@ def add_arguments(parser):
 def run(args):
     from ..evaluate import evaluate, parse_faults
     from ..report import evaluation_text
+    from ..sb3.algorithms import torch_device
+    torch_device(args.device)   # a device torch cannot use: one line, before any work
     result = evaluate(args.strategy, args.map, args.agents, episodes=args.episodes, tests=args.tests,
                       steps=args.steps, seed=args.seed, faults=parse_faults(args.faults),
-                      progress=not args.no_progress, deterministic=not args.stochastic)
+                      progress=not args.no_progress, deterministic=not args.stochastic, device=args.device)
     print(evaluation_text(result))
     if args.json:
         with open(args.json, "w") as fh:

@@ -20,6 +20,8 @@ def add_arguments(parser):
                              "env.episode_steps=1000")
     parser.add_argument("--eval-freq", type=int, default=None, help="agent-steps between evaluations (0: none)")
     parser.add_argument("--checkpoint-freq", type=int, default=None, help="agent-steps between checkpoints")
+    parser.add_argument("--device", default="auto", choices=["auto", "cpu", "cuda"],
+                        help="where the networks train (default auto: cuda when torch sees one, else cpu)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--verbose", type=int, default=0)
 
@@ -33,6 +35,7 @@ def run(args):
                     seed=args.seed, resume=args.resume, init_from=args.init_from, hyperparams=parse_set(args.set),
                     hyperparams_file=args.hyperparams, eval_freq=args.eval_freq,
                     checkpoint_freq=args.checkpoint_freq, progress_bar=not args.no_progress,
-                    verbose=args.verbose, run_id=args.run_id, command="patrolsb3 " + " ".join(sys.argv[1:]))
+                    verbose=args.verbose, run_id=args.run_id, command="patrolsb3 " + " ".join(sys.argv[1:]),
+                    device=args.device)
     print(f"run folder: {run_dir}")
     return 0

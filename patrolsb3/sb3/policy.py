@@ -207,27 +207,32 @@ class PatrolRecurrentPolicy(_RoleExtractorMixin, RecurrentActorCriticPolicy):
 
     @staticmethod
     def _process_sequence(features: th.Tensor, lstm_states: tuple[th.Tensor, th.Tensor],
-                          episode_starts: th.Tensor, lstm: nn.LSTM) -> tuple[th.Tensor, tuple[th.Tensor, th.Tensor]]:
+                          episode_starts: th.Tensor, lstm: nn.LSTM,
+                          by_hand: bool = False) -> tuple[th.Tensor, tuple[th.Tensor, th.Tensor]]:
         """LSTM over padded sequences in one call when episodes only start at a sequence's
         first step (always true for RecurrentRolloutBuffer's sequences and for collection);
-        otherwise sb3-contrib's step-by-step loop. Same result, far fewer kernel launches."""
+        otherwise sb3-contrib's step-by-step loop. Same result, far fewer kernel launches.
+        ``by_hand``: a single step is computed by :func:`lstm_step` (the rollout's forward;
+        ``predict`` keeps the fused kernel, so evaluations reproduce bit for bit)."""
         n_seq = lstm_states[0].shape[1]
         starts = episode_starts.reshape((n_seq, -1))                                   # (n_seq, T)
         if starts.shape[1] > 1 and bool(th.any(starts[:, 1:] != 0)):
             return RecurrentActorCriticPolicy._process_sequence(features, lstm_states, episode_starts, lstm)
         keep = (1.0 - starts[:, 0]).view(1, n_seq, 1)                                  # (1, n_seq, 1)
-        if starts.shape[1] == 1 and lstm.num_layers == 1:    # one step (a rollout): the cell by hand
+        if by_hand and starts.shape[1] == 1 and lstm.num_layers == 1:    # one step: the cell by hand
             return lstm_step(features, (keep * lstm_states[0], keep * lstm_states[1]), lstm)
         sequence = features.reshape((n_seq, -1, lstm.input_size)).swapaxes(0, 1)       # (T, n_seq, F)
         output, states = lstm(sequence, (keep * lstm_states[0], keep * lstm_states[1]))
         return th.flatten(output.transpose(0, 1), start_dim=0, end_dim=1), states      # (n_seq*T, hidden)
 
-    def _latents(self, obs: th.Tensor, lstm_states: RNNStates, episode_starts: th.Tensor):
+    def _latents(self, obs: th.Tensor, lstm_states: RNNStates, episode_starts: th.Tensor, by_hand: bool = False):
         """Actor and critic latents and the new states (the recurrent half of forward)."""
         pi_features, vf_features = self.extract_features(obs)
-        latent_pi, states_pi = self._process_sequence(pi_features, lstm_states.pi, episode_starts, self.lstm_actor)
+        latent_pi, states_pi = self._process_sequence(pi_features, lstm_states.pi, episode_starts, self.lstm_actor,
+                                                      by_hand)
         if self.lstm_critic is not None:
-            latent_vf, states_vf = self._process_sequence(vf_features, lstm_states.vf, episode_starts, self.lstm_critic)
+            latent_vf, states_vf = self._process_sequence(vf_features, lstm_states.vf, episode_starts,
+                                                          self.lstm_critic, by_hand)
         else:
             latent_vf, states_vf = self.critic(vf_features), states_pi
         return (self.mlp_extractor.forward_actor(latent_pi), self.mlp_extractor.forward_critic(latent_vf),
@@ -247,7 +252,7 @@ class PatrolRecurrentPolicy(_RoleExtractorMixin, RecurrentActorCriticPolicy):
         logits (masked logits set to its -1e8, a log-softmax per action dimension): the same
         distribution without building one ``Categorical`` object per dimension per step.
         """
-        latent_pi, latent_vf, states = self._latents(obs, lstm_states, episode_starts)
+        latent_pi, latent_vf, states = self._latents(obs, lstm_states, episode_starts, by_hand=True)
         if action_masks is None:
             distribution = self._masked_distribution(latent_pi, None)
             actions = distribution.get_actions(deterministic=deterministic)

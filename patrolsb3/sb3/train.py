@@ -27,7 +27,7 @@ import numpy as np
 import yaml
 from stable_baselines3.common.vec_env import VecNormalize
 
-from .algorithms import DEFAULT_ALGORITHM, get_algorithm
+from .algorithms import DEFAULT_ALGORITHM, get_algorithm, torch_device
 from .cpu_time import cpu_hours_of
 from .curriculum import CURRICULUM, curriculum_stage
 from .hyperparams import load_hyperparams, merge, per_phase, schedule
@@ -272,7 +272,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
           seed: int = 0, resume: bool = False, init_from=None, hyperparams: dict | None = None, hyperparams_file=None,
           n_envs: int | None = None, eval_freq: int | None = None, checkpoint_freq: int | None = None,
           progress_bar: bool = True, verbose: int = 0, run_id: str | None = None, run_dir=None,
-          command: str | None = None) -> Path:
+          command: str | None = None, device: str = "auto") -> Path:
     """Train a parameter-shared policy and write its run folder (see module docstring).
 
     Args:
@@ -296,6 +296,8 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
         run_id: folder name of the run (default ``<algo>_seed<seed>``).
         run_dir: the full run folder (overrides out/map/variant/run_id).
         command: the command line recorded in command.txt (default: sys.argv).
+        device: where the networks train: "auto" (cuda when torch sees one, else cpu), "cpu"
+            or "cuda". The simulator always runs on the CPU.
 
     Returns:
         The run folder.
@@ -318,6 +320,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
 
     spec_map = load_map(map)
     variant_overrides(variant)  # unknown variant -> ValueError listing the known ones
+    device = torch_device(device)  # a device torch cannot use: one line, before any work
     shortcuts = {k: v for k, v in dict(n_envs=n_envs, eval_freq=eval_freq, checkpoint_freq=checkpoint_freq,
                                        algo=algo, timesteps=timesteps).items() if v is not None}
     hp = resolve_hyperparams(spec_map.name, hyperparams_file, merge(hyperparams or {}, shortcuts))
@@ -362,7 +365,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     if hp.get("normalize_reward", False):
         vec_env = normalized_rewards(vec_env, checkpoint, per_phase(hp["gamma"], vec_env.phases_per_step))
     if checkpoint is not None:
-        model = cls.load(checkpoint, env=vec_env, device="cpu", tensorboard_log=str(run_dir / "tb"),
+        model = cls.load(checkpoint, env=vec_env, device=device, tensorboard_log=str(run_dir / "tb"),
                          verbose=verbose)
         model._last_obs = None  # the saved observation belongs to the old env: learn() resets
         if verbose:
@@ -370,7 +373,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     else:
         kwargs = algorithm_kwargs(hp, spec, vec_env.layout, vec_env.phases_per_step, rows)
         model = cls(policy_cls, vec_env, tensorboard_log=str(run_dir / "tb"), seed=seed, verbose=verbose,
-                    device="cpu", **kwargs)
+                    device=device, **kwargs)
         if warm_weights is not None:
             try:
                 model.policy.load_state_dict(warm_weights)
