@@ -11,7 +11,7 @@ from pettingzoo.utils.conversions import parallel_to_aec
 from .core import protocol
 from .core.config import ENV_VERSION, EnvConfig, make_config
 from .core.maps import STAY, load_map
-from .core.observe import vector_size
+from .core.observe import grid_channels, vector_size
 from .core.state import STATUS_NAMES, reset_state
 
 
@@ -23,7 +23,7 @@ class PatrolParallelEnv(ParallelEnv):
     action is (0, Stay), their reward is 0 and their observation says inactive.
 
     Observation (``Dict``), per agent:
-        * ``grid``: Box(-1, 1, (2, H, W), float32): channel 0 positions and messages, channel 1
+        * ``grid``: Box(-1, 1, (C, H, W), float32): channel 0 positions and messages, channel 1
           normalised idleness (see :mod:`patrolsb3.core.observe`).
         * ``vector``: Box(-1, 1, (15,), float32): battery fraction, own move mask (5), phase
           (0 message, 1 move), active flag, home distance, battery margin, home direction (5).
@@ -80,7 +80,7 @@ class PatrolParallelEnv(ParallelEnv):
         H, W = self.spec_map.shape
         A = self.cfg.max_agents
         self._obs_space = spaces.Dict({
-            "grid": spaces.Box(-1.0, 1.0, (2, H, W), np.float32),
+            "grid": spaces.Box(-1.0, 1.0, (grid_channels(self.cfg), H, W), np.float32),
             "vector": spaces.Box(-1.0, 1.0, (vector_size(self.cfg),), np.float32),
             "critic": spaces.Box(0.0, 1.0, (3 * A,), np.float32),
         })

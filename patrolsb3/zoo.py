@@ -74,17 +74,57 @@ class ZooPolicy:
         self.layout = protocol.ObservationLayout.of(spec, cfg)
         self.recurrent = hasattr(policy, "lstm_actor")
 
-    def _act(self, sim_state, phase: int, lstm, starts):
+    def act_phase(self, sim_state, phase: int, lstm, starts, deterministic: bool = True):
+        """One phase's actions for every slot of ``sim_state``.
+
+        Args:
+            sim_state: the batched simulator ``State`` (E episodes), its symbols as they are
+                shown in this phase.
+            phase: protocol.MESSAGE_PHASE or MOVE_PHASE.
+            lstm: the recurrent state of the previous call (None at the start).
+            starts: (E * A,) bool, rows whose episode starts here.
+            deterministic: most likely legal action, else a sample.
+
+        Returns:
+            (E, A, 2) int64 actions (message index, move) and the new recurrent state.
+        """
         decision = protocol.decide(self.spec, self.cfg, sim_state, phase)
         E, A = sim_state.pos.shape
         masks = decision.masks.reshape(E * A, -1)                              # (E*A, n_symbols + 5)
         obs = decision.flat(self.layout).reshape(E * A, -1)                    # (E*A, layout.size)
         if self.recurrent:
             actions, lstm = self.policy.predict(obs, state=lstm, episode_start=starts,
-                                               deterministic=self._deterministic, action_masks=masks)
+                                               deterministic=deterministic, action_masks=masks)
         else:
-            actions, _ = self.policy.predict(obs, deterministic=self._deterministic, action_masks=masks)
+            actions, _ = self.policy.predict(obs, deterministic=deterministic, action_masks=masks)
         return np.asarray(actions).reshape(E, A, 2), lstm
+
+    def move_probabilities(self, sim_state, lstm):
+        """The move distribution of every slot in the move phase of ``sim_state``, continuing
+        from the recurrent state ``lstm`` (that of the step's message phase, or of the last step).
+
+        Returns:
+            (E, A, 5) float64 probabilities (0 on masked moves) and the new recurrent state.
+        """
+        import torch as th
+        decision = protocol.decide(self.spec, self.cfg, sim_state, protocol.MOVE_PHASE)
+        E, A = sim_state.pos.shape
+        device = self.policy.device
+        obs = th.as_tensor(decision.flat(self.layout).reshape(E * A, -1), device=device)
+        masks = th.as_tensor(decision.masks.reshape(E * A, -1), device=device)
+        with th.no_grad():
+            if self.recurrent:
+                if lstm is None:
+                    shape = self.policy.lstm_hidden_state_shape
+                    lstm = (np.zeros((shape[0], E * A, shape[2]), np.float32),) * 2
+                states = tuple(th.as_tensor(np.asarray(x), dtype=th.float32, device=device) for x in lstm)
+                starts = th.zeros(E * A, dtype=th.float32, device=device)
+                distribution, states = self.policy.get_distribution(obs, states, starts, action_masks=masks)
+                lstm = (states[0].cpu().numpy(), states[1].cpu().numpy())
+            else:
+                distribution = self.policy.get_distribution(obs, action_masks=masks)
+        probs = distribution.distributions[-1].probs                             # the move dimension
+        return probs.cpu().numpy().astype(np.float64).reshape(E, A, -1), lstm
 
     def seed_sampling(self, seed: int) -> None:
         """Seed torch's generator, which draws the sampled actions (``deterministic=False``)."""
@@ -104,7 +144,6 @@ class ZooPolicy:
             actions (E, A, 2) int64 (message symbol 0..16, move 0..4) and the recurrent state.
         """
         sim = observation
-        self._deterministic = deterministic
         E, A = sim.pos.shape
         if episode_start is None:
             episode_start = np.full(E, state is None)
@@ -112,12 +151,12 @@ class ZooPolicy:
         active = sim.active
         if self.cfg.two_phase:
             silent = dataclasses.replace(sim, messages=np.zeros_like(sim.messages))
-            chosen, state = self._act(silent, protocol.MESSAGE_PHASE, state, starts)
+            chosen, state = self.act_phase(silent, protocol.MESSAGE_PHASE, state, starts, deterministic)
             symbols = protocol.symbols_of(chosen[..., 0], active)
             shown = dataclasses.replace(sim, messages=symbols)
-            chosen, state = self._act(shown, protocol.MOVE_PHASE, state, np.zeros_like(starts))
+            chosen, state = self.act_phase(shown, protocol.MOVE_PHASE, state, np.zeros_like(starts), deterministic)
         else:
-            chosen, state = self._act(sim, protocol.MOVE_PHASE, state, starts)
+            chosen, state = self.act_phase(sim, protocol.MOVE_PHASE, state, starts, deterministic)
             symbols = protocol.symbols_of(chosen[..., 0], active & (self.cfg.comm != "none"))
         return np.stack([symbols, chosen[..., 1]], axis=-1).astype(np.int64), state
 

@@ -22,6 +22,14 @@ def test_parallel_api(comm, timing):
     parallel_api_test(env, num_cycles=200)
 
 
+@pytest.mark.parametrize("comm", ["learned", "none"])
+def test_parallel_api_with_symbol_planes(comm):
+    env = patrolsb3.parallel_env("A", n_agents=3, seed=0, comm=comm, invalid_action="stay", episode_steps=60,
+                                 message_encoding="planes")
+    assert env.observation_space("drone_0")["grid"].shape == (18, 12, 12)
+    parallel_api_test(env, num_cycles=100)
+
+
 @pytest.mark.parametrize("comm, timing", MODES)
 def test_parallel_seed(comm, timing):
     parallel_seed_test(lambda: patrolsb3.parallel_env("C", n_agents=4, comm=comm,

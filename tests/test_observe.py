@@ -107,3 +107,24 @@ def test_local_idleness_copies_the_idleness_of_the_cell_each_move_leads_to(non_s
     assert np.array_equal(vector[..., :VECTOR_SIZE], plain)
     # the values are grid channel 1 next to the agent: Up from (1, 4) reads (0, 4)
     assert vector[0, 0, VECTOR_SIZE] == grid[0, 0, 1, 0, 4]
+
+
+def test_symbol_planes_are_legible(non_square_map):
+    """message_encoding='planes': positions at full scale on channel 0, one plane per symbol."""
+    spec = non_square_map
+    cfg = deterministic_config(max_agents=3, message_encoding="planes")
+    state = place(spec, cfg, [(1, 4), (2, 6)], battery=[275.0, 550.0])
+    state.messages[0] = [3, 16, 0]
+    grid, _ = actor_observation(spec, cfg, state)
+    assert grid.shape == (1, 3, 2 + 16, 3, 7)
+    me, other, absent = grid[0, 0], grid[0, 1], grid[0, 2]
+    assert me[0, 1, 4] == 1.0 and me[0, 2, 6] == -0.5 and me[0, 0, 0] == 0.5 and me[0, 0, 3] == -1.0
+    assert other[0, 1, 4] == -0.5 and other[0, 2, 6] == 1.0
+    # plane 1 + s holds symbol s: own +1, others -1, nothing else anywhere
+    assert me[1 + 3, 1, 4] == 1.0 and me[1 + 16, 2, 6] == -1.0
+    assert other[1 + 3, 1, 4] == -1.0 and other[1 + 16, 2, 6] == 1.0
+    assert np.count_nonzero(me[2:]) == 2 and np.count_nonzero(other[2:]) == 2
+    assert absent[0, 1, 4] == -0.5 and absent[1 + 3, 1, 4] == -1.0 and np.count_nonzero(absent[2:]) == 2
+    # idleness is channel 1 in both encodings
+    scalar, _ = actor_observation(spec, deterministic_config(max_agents=3), state)
+    np.testing.assert_array_equal(grid[:, :, 1], scalar[:, :, 1])

@@ -138,5 +138,5 @@ def test_protocol_signature_separates_what_changes_the_spaces():
     base = make_config()
     assert protocol.protocol_signature(base) == protocol.protocol_signature(make_config(episode_steps=7))
     for change in ({"local_idleness": True}, {"comm": "none"}, {"max_agents": 4},
-                   {"message_timing": "delayed"}):
+                   {"message_timing": "delayed"}, {"message_encoding": "planes"}):
         assert protocol.protocol_signature(base) != protocol.protocol_signature(make_config(**change))

@@ -1,6 +1,7 @@
 """``patrolsb3 zoo list``: every zoo entry with its budget, date, env version and headline
 figures; ``patrolsb3 zoo show MAP VARIANT``: one entry's config and evaluation; ``patrolsb3 zoo
-export RUN``: a run into the zoo; ``patrolsb3 zoo validate RUN``: rank a run's checkpoints."""
+export RUN``: a run into the zoo; ``patrolsb3 zoo validate RUN``: rank a run's checkpoints;
+``patrolsb3 zoo listening MAP VARIANT``: what its messages carry (:mod:`patrolsb3.listening`)."""
 import json
 import math
 
@@ -35,6 +36,16 @@ def add_arguments(parser):
     p_val.add_argument("--steps", type=int, default=3000, help="steps per episode (default 3000 = 5 h)")
     p_val.add_argument("--seed", type=int, default=7, help="simulator seed (default 7; the zoo's eval uses 0)")
     p_val.add_argument("--last", type=int, default=None, help="only the newest N checkpoints")
+    p_lis = sub.add_parser("listening", help="how much an entry's moves depend on the symbols it receives "
+                                             "(KL and greedy change when they are randomised) and how it "
+                                             "uses its alphabet")
+    p_lis.add_argument("map")
+    p_lis.add_argument("variant", help="rl-msg or rl-intention")
+    p_lis.add_argument("--zoo-dir", default=None)
+    p_lis.add_argument("--agents", type=int, default=3, help="team size (default 3)")
+    p_lis.add_argument("--episodes", type=int, default=8, help="parallel episodes (default 8)")
+    p_lis.add_argument("--steps", type=int, default=500, help="simulator steps (default 500)")
+    p_lis.add_argument("--seed", type=int, default=1000, help="seed (default 1000; the zoo's eval uses 0)")
 
 
 def headline(entry: dict) -> str:
@@ -57,6 +68,13 @@ def run(args):
         return export_and_evaluate(args)
     if args.zoo_command == "validate":
         return validate_checkpoints(args)
+    if args.zoo_command == "listening":
+        from ..listening import listening
+        from ..zoo import load
+        figures = listening(load(args.map, args.variant, zoo_dir=args.zoo_dir), n_agents=args.agents,
+                            episodes=args.episodes, steps=args.steps, seed=args.seed)
+        print(json.dumps({"entry": f"{args.map.upper()}/{args.variant}", **figures}))
+        return 0
     if args.zoo_command == "show":
         print(json.dumps(read_entry(entry_dir(args.map, args.variant, args.zoo_dir)), indent=2, default=str))
         return 0

@@ -12,6 +12,7 @@ ENV_VERSION = "patrol_v1"
 
 COMM_MODES = ("none", "learned", "intention")
 MESSAGE_TIMINGS = ("same_step", "delayed")
+MESSAGE_ENCODINGS = ("scalar", "planes")
 INVALID_ACTION_MODES = ("raise", "stay")
 
 # Per-map parameter changes taken from the paper (c_pbb is 0.5 on map B).
@@ -89,6 +90,15 @@ class EnvConfig:
     symbols before moving; 'delayed': message and move are chosen together and the symbols
     are seen at the next step (classic RIAL)."""
 
+    message_encoding: str = "scalar"
+    """How positions and symbols reach the actor's grid. 'scalar' (the default, what the zoo's
+    entries before 2026-12 were trained with): one channel holds both, an agent's cell showing
+    (1 + symbol) / (n_symbols + 2), own positive, others negative, so neighbouring symbols
+    differ by ~0.06. 'planes' (OURS, legible): channel 0 holds positions at full scale (self +1,
+    others -0.5, station +0.5, obstacle -1), and n_symbols more channels hold one plane per
+    symbol, +1 on the agent's own cell for its own symbol and -1 on each other agent's cell for
+    theirs; every variant sees the positions alike (see ``core/observe.py``)."""
+
     fault_prob: float = 0.0
     """Per-step probability that each active agent suffers a hardware failure."""
     faults: tuple = ()
@@ -104,6 +114,8 @@ class EnvConfig:
             raise ValueError(f"comm must be one of {COMM_MODES}, got {self.comm!r}")
         if self.message_timing not in MESSAGE_TIMINGS:
             raise ValueError(f"message_timing must be one of {MESSAGE_TIMINGS}, got {self.message_timing!r}")
+        if self.message_encoding not in MESSAGE_ENCODINGS:
+            raise ValueError(f"message_encoding must be one of {MESSAGE_ENCODINGS}, got {self.message_encoding!r}")
         if self.invalid_action not in INVALID_ACTION_MODES:
             raise ValueError(f"invalid_action must be one of {INVALID_ACTION_MODES}, got {self.invalid_action!r}")
         if self.c_home < 0:

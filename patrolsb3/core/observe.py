@@ -12,6 +12,14 @@ Grid channel 0 (positions and messages), values divided by ``n_symbols + 2``:
 Grid channel 1 (idleness): f(i) = 1 - exp(-i / c_norm) on vertices (1 if never visited),
 -1 on obstacles, 0 on stations.
 
+With ``cfg.message_encoding == 'planes'`` (OURS, legible messages) channel 0 holds positions
+only, at full scale (self +1, other agents -0.5, station +0.5, obstacle -1, vertex 0; others on
+a station are not drawn, as above), and channels 2 .. 1 + n_symbols hold one plane per symbol:
+plane 1 + s is +1 on the observer's own cell when it shows symbol s and -1 on the cell of
+every other agent (drawn on channel 0) showing s. Symbols then differ by a whole channel, not
+by 0.06 of one, and every variant sees the others' positions at the same scale. With 'scalar'
+messages (the default) the layout is the paper-like one above.
+
 Vector: [own battery fraction, own move mask (5), phase (0 message, 1 move), active flag,
 home distance, battery margin, home direction (5)]:
 
@@ -52,6 +60,15 @@ VECTOR_SIZE = 15
 LOCAL_IDLENESS_SIZE = 5
 """Values the local idleness adds (one per move)."""
 _ONE_HOT = np.eye(5, dtype=np.float32)  # (5, 5) one-hot row of each move
+OTHER_AGENT = -0.5
+"""'planes' messages: channel 0 value of another agent's cell (self is +1, obstacle -1)."""
+STATION_PLANES = 0.5
+"""'planes' messages: channel 0 value of a station (no agent's value)."""
+
+
+def grid_channels(cfg: EnvConfig) -> int:
+    """Channels of the actor's grid: 2 ('scalar' messages), 2 + n_symbols ('planes')."""
+    return 2 + (cfg.n_symbols if cfg.message_encoding == "planes" else 0)
 
 
 def vector_size(cfg: EnvConfig) -> int:
@@ -76,10 +93,26 @@ def home_features(spec: MapSpec, cfg: EnvConfig, state: State) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=64)
-def _position_base(spec: MapSpec) -> np.ndarray:
-    """(H*W,) float32 channel 0 without agents: vertex 0, obstacle -1, station +1."""
+def _position_base(spec: MapSpec, planes: bool = False) -> np.ndarray:
+    """(H*W,) float32 channel 0 without agents: vertex 0, obstacle -1, station +1 ('scalar'
+    messages) or STATION_PLANES ('planes')."""
     kinds = spec.kinds.ravel()
-    return np.where(kinds == OBSTACLE, -1.0, np.where(kinds == STATION, 1.0, 0.0)).astype(np.float32)
+    station = STATION_PLANES if planes else 1.0
+    return np.where(kinds == OBSTACLE, -1.0, np.where(kinds == STATION, station, 0.0)).astype(np.float32)
+
+
+def _draw_symbol_planes(grid: np.ndarray, state: State, drawn: np.ndarray) -> None:
+    """Write the symbol planes of 'planes' messages into ``grid`` (E, A, 2 + n_symbols, H*W):
+    plane 2 + (s - 1) holds symbol s, +1 on an observer's own cell for its own symbol, -1 on
+    the cell of every other agent drawn on channel 0 (off the station) for theirs. Silent
+    slots (symbol 0) draw nothing."""
+    A = state.pos.shape[1]
+    speaks = drawn & (state.messages > 0)                                      # (E, A) others we draw
+    seen = speaks[:, None, :] & ~np.eye(A, dtype=bool)[None]                   # (E, observer, other)
+    e_o, i_o, j_o = np.nonzero(seen)
+    grid[e_o, i_o, 1 + state.messages[e_o, j_o], state.pos[e_o, j_o]] = -1.0
+    e_s, i_s = np.nonzero(state.active & (state.messages > 0))
+    grid[e_s, i_s, 1 + state.messages[e_s, i_s], state.pos[e_s, i_s]] = 1.0
 
 
 @functools.lru_cache(maxsize=64)
@@ -105,25 +138,31 @@ def actor_observation(spec: MapSpec, cfg: EnvConfig, state: State, phase: int = 
         mask: (E, A, 5) move mask if already computed.
 
     Returns:
-        grid (E, A, 2, H, W) float32 and vector (E, A, vector_size(cfg)) float32.
+        grid (E, A, grid_channels(cfg), H, W) float32 and vector (E, A, vector_size(cfg)) float32.
     """
     E, A = state.pos.shape
     H, W = spec.shape
-    scale = float(cfg.n_symbols + 2)
+    planes = cfg.message_encoding == "planes"
     kinds = spec.kinds.ravel()
     active = state.active                                                      # (E, A)
-    value = (1.0 + state.messages) / scale                                     # (E, A) slot j's value
-    # what every observer sees of the others: agents off the station, drawn negative (active
-    # agents never share a cell off the station, so no two writes collide)
-    shared = np.broadcast_to(_position_base(spec), (E, H * W)).copy()         # (E, H*W)
+    if planes:   # positions at full scale; the symbols go to their own planes below
+        own, other = np.ones((E, A)), np.full((E, A), OTHER_AGENT)             # (E, A) each
+    else:
+        own = (1.0 + state.messages) / float(cfg.n_symbols + 2)                # (E, A) slot j's value
+        other = -own
+    # what every observer sees of the others: agents off the station (active agents never
+    # share a cell off the station, so no two writes collide)
+    shared = np.broadcast_to(_position_base(spec, planes), (E, H * W)).copy()  # (E, H*W)
     drawn = active & (kinds != STATION)[state.pos]                             # (E, A)
     e_d, j_d = np.nonzero(drawn)
-    shared[e_d, state.pos[e_d, j_d]] = -value[e_d, j_d]
-    grid = np.empty((E, A, 2, H * W), dtype=np.float32)
+    shared[e_d, state.pos[e_d, j_d]] = other[e_d, j_d]
+    grid = np.zeros((E, A, grid_channels(cfg), H * W), dtype=np.float32)
     grid[:, :, 0] = shared[:, None, :]
     # each active observer sees itself positive on its own cell (station included)
     e_s, i_s = np.nonzero(active)
-    grid[e_s, i_s, 0, state.pos[e_s, i_s]] = value[e_s, i_s]
+    grid[e_s, i_s, 0, state.pos[e_s, i_s]] = own[e_s, i_s]
+    if planes:
+        _draw_symbol_planes(grid, state, drawn)
 
     f = normalised_idleness(state.idle, state.visited, cfg.c_norm)              # (E, V)
     chan1 = np.broadcast_to(_idleness_base(spec), (E, H * W)).copy()            # (E, H*W)
@@ -144,7 +183,7 @@ def actor_observation(spec: MapSpec, cfg: EnvConfig, state: State, phase: int = 
         local[~spec.move_ok[state.pos]] = -1.0                                 # off map, obstacle
         local[~active] = 0.0
         vector[..., VECTOR_SIZE:] = local
-    return grid.reshape(E, A, 2, H, W), vector
+    return grid.reshape(E, A, grid.shape[2], H, W), vector
 
 
 def critic_state(spec: MapSpec, cfg: EnvConfig, state: State) -> np.ndarray:

@@ -28,7 +28,7 @@ import numpy as np
 from .config import EnvConfig
 from .maps import STAY, MapSpec
 from .masks import action_mask, composite_action_mask
-from .observe import actor_observation, critic_state, vector_size
+from .observe import actor_observation, critic_state, grid_channels, vector_size
 from .state import State
 from .step import InvalidActionError, StepInfo
 from .step import step as core_step
@@ -56,7 +56,7 @@ def phases_per_step(cfg: EnvConfig) -> int:
 def protocol_signature(cfg: EnvConfig) -> tuple:
     """What fixes the spaces and phases: two configs with the same signature can run side by
     side in one vector env (per-episode settings such as ``episode_steps`` may differ)."""
-    return (cfg.max_agents, cfg.n_symbols, cfg.two_phase, vector_size(cfg), cfg.comm)
+    return (cfg.max_agents, cfg.n_symbols, cfg.two_phase, vector_size(cfg), grid_channels(cfg), cfg.comm)
 
 
 def check_team(spec: MapSpec, cfg: EnvConfig, n_agents) -> int:
@@ -96,7 +96,8 @@ class ObservationLayout:
     """Where each part of a flat observation row sits.
 
     Attributes:
-        grid_shape: (2, H, W) grid channels (positions and messages, idleness).
+        grid_shape: (C, H, W) grid: C = 2 (positions and messages, idleness) or 2 + n_symbols
+            (positions, idleness, one plane per symbol), see ``EnvConfig.message_encoding``.
         vector_size: length of the actor's vector part.
         critic_size: length of the centralised critic part (3 * max_agents).
         max_agents: slots per episode.
@@ -111,7 +112,7 @@ class ObservationLayout:
     def of(cls, spec: MapSpec, cfg: EnvConfig) -> "ObservationLayout":
         """The layout of ``cfg`` on map ``spec``."""
         H, W = spec.shape
-        return cls((2, H, W), vector_size(cfg), 3 * cfg.max_agents, cfg.max_agents)
+        return cls((grid_channels(cfg), H, W), vector_size(cfg), 3 * cfg.max_agents, cfg.max_agents)
 
     @property
     def grid_size(self) -> int:
