@@ -24,7 +24,9 @@ COMMANDS = {
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every sub-command registered."""
+    from . import __version__
     parser = argparse.ArgumentParser(prog="patrolsb3", description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action="version", version=f"patrolsb3 {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, help_text in COMMANDS.items():
         module = importlib.import_module(f"patrolsb3.commands.{name}")

@@ -22,17 +22,45 @@ from .core import protocol
 from .core.config import ENV_VERSION, EnvConfig, make_config
 from .core.maps import MapSpec, load_map
 
-ZOO_DIR = Path(__file__).resolve().parent.parent / "zoo"
-VARIANT_NAMES = ("rl-msg", "rl-no-msg", "rl-intention")
-
 
 class ZooError(ValueError):
     """A zoo entry that is missing, incomplete or incompatible with this code."""
 
 
+ZOO_DIR = Path(__file__).resolve().parent.parent / "zoo"
+"""The checkout's zoo (the zoo ships with the git repository, not with the wheel)."""
+ZOO_ENV = "PATROLSB3_ZOO"
+"""Environment variable naming a zoo folder (e.g. a clone's ``zoo/``) for an installed package."""
+
+
+def zoo_root(zoo_dir=None) -> Path:
+    """Where the zoo is: ``zoo_dir`` if given, else ``$PATROLSB3_ZOO``, else the checkout's ``zoo/``.
+
+    Raises:
+        ZooError: none of them is a folder; the message says where it looked and how to get it.
+    """
+    import os
+    if zoo_dir is not None:
+        return Path(zoo_dir)
+    if os.environ.get(ZOO_ENV):
+        root = Path(os.environ[ZOO_ENV])
+        if not root.is_dir():
+            raise ZooError(f"${ZOO_ENV}={root} is not a folder; point it at the zoo/ folder of a "
+                           f"patrolsb3 clone")
+        return root
+    if ZOO_DIR.is_dir():
+        return ZOO_DIR
+    raise ZooError(f"no zoo found (looked for ${ZOO_ENV} and {ZOO_DIR.name}/ beside the package): the zoo "
+                   f"ships with the git repository, not the wheel; clone it and set {ZOO_ENV} to its zoo/ "
+                   f"folder, or pass zoo_dir=")
+
+
+VARIANT_NAMES = ("rl-msg", "rl-no-msg", "rl-intention")
+
+
 def entry_dir(map_name: str, variant: str, zoo_dir=None) -> Path:
     """Folder of one zoo entry (it need not exist)."""
-    return Path(zoo_dir or ZOO_DIR) / str(map_name).upper() / variant
+    return zoo_root(zoo_dir) / str(map_name).upper() / variant
 
 
 def read_entry(path: Path) -> dict:
@@ -48,13 +76,16 @@ def read_entry(path: Path) -> dict:
 
 def list_entries(zoo_dir=None) -> list[dict]:
     """Every entry of the zoo (maps A..D x variants), sorted by map then variant."""
-    root = Path(zoo_dir or ZOO_DIR)
+    root = zoo_root(zoo_dir)
     return [read_entry(p.parent) for p in sorted(root.glob("*/*/config.yml"))]
 
 
 def available(map_name: str, variant: str, zoo_dir=None) -> bool:
-    """True when the zoo has a model for (map, variant)."""
-    return (entry_dir(map_name, variant, zoo_dir) / "model.zip").is_file()
+    """True when the zoo has a model for (map, variant); False also when there is no zoo."""
+    try:
+        return (entry_dir(map_name, variant, zoo_dir) / "model.zip").is_file()
+    except ZooError:
+        return False
 
 
 class ZooPolicy:

@@ -32,7 +32,15 @@ ACTION_NAMES = ("Up", "Down", "Left", "Right", "Stay")
 UP, DOWN, LEFT, RIGHT, STAY = range(5)
 MOVES = np.array([[-1, 0], [1, 0], [0, -1], [0, 1], [0, 0]], dtype=np.int64)  # (5, 2)
 
-MAPS_DIR = Path(__file__).resolve().parent.parent.parent / "maps"
+def _shipped_maps_dir() -> Path:
+    """The shipped maps: ``patrolsb3/maps/`` in an installed wheel, else the checkout's
+    top-level ``maps/`` (setup.cfg maps one onto the other)."""
+    package = Path(__file__).resolve().parent.parent
+    installed = package / "maps"
+    return installed if installed.is_dir() else package.parent / "maps"
+
+
+MAPS_DIR = _shipped_maps_dir()
 
 
 class MapError(ValueError):
