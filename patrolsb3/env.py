@@ -12,15 +12,29 @@ from .core import protocol
 from .core.config import ENV_VERSION, EnvConfig, make_config
 from .core.maps import STAY, load_map
 from .core.observe import grid_channels, vector_size
-from .core.state import STATUS_NAMES, reset_state
+from .core.state import reset_state
+
+INFO_KEYS = ("action_mask", "action_mask_flat", "phase", "status", "battery", "step", "collided",
+             "collisions", "pushed", "swap_started", "swap_battery", "battery_failed", "fault_failed",
+             "mean_idleness", "max_idleness", "team_patrol_reward")
+"""The keys of every agent's info, at every step: ``action_mask`` (message (n_symbols,), move
+(5,)) int8, PettingZoo's convention for MultiDiscrete; ``action_mask_flat`` the same as one
+(n_symbols + 5,) int8 array; ``phase`` 0 message / 1 move (:mod:`patrolsb3.core.protocol`);
+``status`` 0 active, 1 swapping, 2 failed (``core.state.STATUS_NAMES``); ``battery`` fraction;
+``step`` simulator steps done; then what the last simulator step did (all 0 / False in a message
+phase): ``collided``, ``collisions`` (events), ``pushed``, ``swap_started``, ``swap_battery``
+(fraction at the swap's start, -1 when none started), ``battery_failed``, ``fault_failed``,
+``mean_idleness`` and ``max_idleness`` (over vertices, after the step), ``team_patrol_reward``."""
 
 
 class PatrolParallelEnv(ParallelEnv):
     """Multi-drone patrolling of a grid map (the paper's model, SPEC.md sections 1-5).
 
-    Agents: ``drone_0 .. drone_{max_agents-1}``; all slots stay in ``agents`` for the whole
-    episode. Slots beyond ``n_agents``, swapping or failed are *inactive*: their only legal
-    action is (0, Stay), their reward is 0 and their observation says inactive.
+    Agents: the team, ``drone_0 .. drone_{n_agents-1}`` (``possible_agents`` lists every slot
+    up to ``max_agents``); they stay in ``agents`` for the whole episode. A swapping or failed
+    agent is *inactive*: its only legal action is (0, Stay), its reward is 0 and its observation
+    says inactive. (Padding every episode to ``max_agents`` rows is the training adapter's
+    business, :mod:`patrolsb3.sb3.batched_env`.)
 
     Observation (``Dict``), per agent:
         * ``grid``: Box(-1, 1, (C, H, W), float32): channel 0 positions and messages, channel 1
@@ -32,7 +46,9 @@ class PatrolParallelEnv(ParallelEnv):
 
     Action: ``MultiDiscrete([n_symbols, 5])`` = (message, move); message index m means symbol
     m + 1; moves are Up, Down, Left, Right, Stay. ``info[agent]["action_mask"]`` is a tuple of
-    two int8 arrays (16,) and (5,), PettingZoo's convention for MultiDiscrete.
+    two int8 arrays (16,) and (5,), PettingZoo's convention for MultiDiscrete, and
+    ``info[agent]["action_mask_flat"]`` the same as one (21,) array. Every info has the keys of
+    :data:`INFO_KEYS`, numeric, at every step.
 
     Phases: with ``comm='learned'`` or ``'intention'`` and ``message_timing='same_step'``
     every simulator step takes two env steps: a message phase (the move must be Stay; the
@@ -124,7 +140,7 @@ class PatrolParallelEnv(ParallelEnv):
             self._check_team(options["n_agents"])
             self.n_agents = int(options["n_agents"])
         self.core_state = reset_state(self.spec_map, self.cfg, self.n_agents, n_envs=1, seed=seed)
-        self.agents = list(self.possible_agents)
+        self.agents = self.possible_agents[:self.n_agents]
         self._last_info = None
         self.episode_collisions = 0
         self._decide(protocol.first_phase(self.cfg))
@@ -133,8 +149,8 @@ class PatrolParallelEnv(ParallelEnv):
     def step(self, actions):
         """Apply one (message, move) action per agent; see the class docstring for phases."""
         act = np.zeros((1, self.cfg.max_agents, 2), dtype=np.int64)             # (1, A, 2)
-        act[..., 1] = STAY
-        for i, name in enumerate(self.possible_agents):
+        act[..., 1] = STAY                                                     # slots not deployed
+        for i, name in enumerate(self.agents):
             if name in actions and actions[name] is not None:
                 act[0, i] = np.asarray(actions[name], dtype=np.int64).reshape(2)
         phase = self.phase
@@ -162,49 +178,41 @@ class PatrolParallelEnv(ParallelEnv):
         self.phase = phase
         self._decision = protocol.decide(self.spec_map, self.cfg, self.core_state, phase)
 
-    def _masks(self):
-        """Per slot (message_mask (n_symbols,), move_mask (5,)) int8, for the current phase."""
-        masks = self._decision.masks[0].astype(np.int8)                          # (A, n_symbols + 5)
-        n = self.cfg.n_symbols
-        return [(masks[i, :n], masks[i, n:]) for i in range(self.cfg.max_agents)]
-
     def _observations(self):
         d = self._decision
         return {name: {"grid": d.grid[0, i], "vector": d.vector[0, i], "critic": d.critic[0]}
-                for i, name in enumerate(self.possible_agents)}
+                for i, name in enumerate(self.agents)}
 
     def _infos(self, info):
-        masks = self._masks()
+        """The info of every agent: the same keys and numeric values at every step (see
+        :data:`INFO_KEYS`); the simulator's figures are 0 in a message phase."""
         s = self.core_state
-        phase = protocol.PHASE_NAMES[self.phase]
-        step_no = int(s.t[0])
+        masks = self._decision.masks[0].astype(np.int8)                          # (A, n_symbols + 5)
+        n = self.cfg.n_symbols
         battery = (s.battery[0] / self.cfg.b_max).tolist()
         status = s.status[0].tolist()
+        stepped = info is not None
         out = {}
-        for i, name in enumerate(self.possible_agents):
-            d = {
-                "action_mask": masks[i],
-                "phase": phase,
-                "status": STATUS_NAMES[status[i]],
+        for i, name in enumerate(self.agents):
+            out[name] = {
+                "action_mask": (masks[i, :n], masks[i, n:]),
+                "action_mask_flat": masks[i],
+                "phase": int(self.phase),
+                "status": int(status[i]),
                 "battery": battery[i],
-                "step": step_no,
+                "step": int(s.t[0]),
+                "collided": stepped and bool(info.collided[0, i]),
+                "collisions": int(info.collisions[0]) if stepped else 0,
+                "pushed": stepped and bool(info.pushed[0, i]),
+                "swap_started": stepped and bool(info.swap_started[0, i]),
+                # -1 (not nan) when no swap started: nan != nan breaks seed checks
+                "swap_battery": float(info.swap_battery[0, i]) if stepped and info.swap_started[0, i] else -1.0,
+                "battery_failed": stepped and bool(info.battery_failed[0, i]),
+                "fault_failed": stepped and bool(info.fault_failed[0, i]),
+                "mean_idleness": float(info.mean_idleness[0]) if stepped else float(s.idle[0].mean()),
+                "max_idleness": float(info.max_idleness[0]) if stepped else float(s.idle[0].max()),
+                "team_patrol_reward": float(info.team_patrol[0]) if stepped else 0.0,
             }
-            if info is not None:
-                d.update({
-                    "collided": bool(info.collided[0, i]),
-                    "collisions": int(info.collisions[0]),
-                    "pushed": bool(info.pushed[0, i]),
-                    "swap_started": bool(info.swap_started[0, i]),
-                    # None (not nan) when no swap started: nan != nan breaks seed checks
-                    "swap_battery": (float(info.swap_battery[0, i]) if info.swap_started[0, i]
-                                     else None),
-                    "battery_failed": bool(info.battery_failed[0, i]),
-                    "fault_failed": bool(info.fault_failed[0, i]),
-                    "mean_idleness": float(info.mean_idleness[0]),
-                    "max_idleness": float(info.max_idleness[0]),
-                    "team_patrol_reward": float(info.team_patrol[0]),
-                })
-            out[name] = d
         return out
 
     # ------------------------------------------------------------------ rendering

@@ -8,7 +8,10 @@ from pettingzoo.test import api_test, parallel_api_test, parallel_seed_test
 import patrolsb3
 from patrolsb3.core import parse_map
 from patrolsb3.core.maps import STAY
+from patrolsb3.core.protocol import MESSAGE_PHASE, MOVE_PHASE
+from patrolsb3.core.state import ACTIVE
 from patrolsb3.core.step import InvalidActionError
+from patrolsb3.env import INFO_KEYS
 
 MODES = [("learned", "same_step"), ("learned", "delayed"), ("none", "same_step"),
          ("intention", "same_step"), ("intention", "delayed")]
@@ -73,7 +76,7 @@ def test_masked_move_is_stay_when_configured():
 def test_message_phase_refuses_a_move_and_a_move_phase_refuses_a_message():
     env = patrolsb3.parallel_env("A", n_agents=2, seed=0, comm="learned")
     obs, infos = env.reset()
-    assert infos["drone_0"]["phase"] == "message"
+    assert infos["drone_0"]["phase"] == MESSAGE_PHASE
     with pytest.raises(ValueError, match="drone_0: action \\(3, 0\\) is not legal in the message phase"):
         env.step({"drone_0": (3, 0), "drone_1": (0, STAY)})
     env.step({"drone_0": (5, STAY), "drone_1": (5, STAY)})
@@ -102,14 +105,14 @@ def test_same_step_messages_take_two_env_steps_and_are_seen_before_moving():
     env = patrolsb3.parallel_env("A", n_agents=2, seed=0, comm="learned", p_dyn_max=0.0)
     obs, infos = env.reset()
     obs, rewards, terms, truncs, infos = env.step({"drone_0": (4, STAY), "drone_1": (9, STAY)})
-    assert rewards == {a: 0.0 for a in env.possible_agents}
-    assert env.core_state.t[0] == 0 and infos["drone_0"]["phase"] == "move"
+    assert rewards == {a: 0.0 for a in env.agents} and env.agents == ["drone_0", "drone_1"]
+    assert env.core_state.t[0] == 0 and infos["drone_0"]["phase"] == MOVE_PHASE
     r, c = divmod(int(env.core_state.pos[0, 1]), 12)
     assert obs["drone_0"]["grid"][0, r, c] == pytest.approx(-(1 + 10) / 18)   # drone_1's symbol 10
     assert obs["drone_0"]["vector"][6] == 1.0
     obs, rewards, terms, truncs, infos = env.step({a: (0, STAY) for a in env.agents})
-    assert env.core_state.t[0] == 1 and infos["drone_0"]["phase"] == "message"
-    assert rewards["drone_0"] > 0 and rewards["drone_2"] == 0.0
+    assert env.core_state.t[0] == 1 and infos["drone_0"]["phase"] == MESSAGE_PHASE
+    assert rewards["drone_0"] > 0 and "drone_2" not in rewards
     assert obs["drone_0"]["grid"][0, r, c] == pytest.approx(-1 / 18)        # symbols cleared
 
 
@@ -129,12 +132,15 @@ def test_info_carries_what_evaluation_needs():
     msg_mask, move_mask = infos["drone_0"]["action_mask"]
     assert msg_mask.dtype == np.int8 and msg_mask.shape == (16,)
     assert move_mask.dtype == np.int8 and move_mask.shape == (5,)
-    assert infos["drone_4"]["status"] == "absent"
-    assert list(infos["drone_4"]["action_mask"][1]) == [0, 0, 0, 0, 1]
+    assert env.agents == ["drone_0", "drone_1", "drone_2"] and "drone_4" not in infos   # the team only
+    assert infos["drone_0"]["status"] == ACTIVE
+    np.testing.assert_array_equal(infos["drone_0"]["action_mask_flat"], np.concatenate([msg_mask, move_mask]))
+    first = infos
     obs, rewards, terms, truncs, infos = env.step({a: (0, STAY) for a in env.agents})
-    for key in ("collided", "collisions", "pushed", "swap_started", "swap_battery",
-                "battery_failed", "fault_failed", "mean_idleness", "max_idleness", "battery"):
+    for key in INFO_KEYS:
         assert key in infos["drone_0"]
+    assert set(first["drone_0"]) == set(infos["drone_0"]) == set(INFO_KEYS)   # one schema at every step
+    assert all(isinstance(v, (int, float, bool, tuple, np.ndarray)) for v in infos["drone_0"].values())
     assert infos["drone_0"]["mean_idleness"] == pytest.approx(env.core_state.idle.mean())
     assert obs["drone_0"]["grid"].shape == (2, 12, 12)
     assert env.observation_space("drone_0").contains(obs["drone_0"])
@@ -165,9 +171,9 @@ def trajectory(seed, comm, timing, n_env_steps=300):
     out = []
     for _ in range(n_env_steps):
         obs, rewards, terms, truncs, infos = env.step(random_masked_actions(infos, env.agents, rng))
-        out.append((np.stack([obs[a]["grid"] for a in env.possible_agents]),
-                    [rewards[a] for a in env.possible_agents],
-                    [infos[a].get("collided") for a in env.possible_agents],
+        out.append((np.stack([obs[a]["grid"] for a in env.agents]),
+                    [rewards[a] for a in env.agents],
+                    [infos[a]["collided"] for a in env.agents],
                     env.core_state.battery.copy()))
     return out
 

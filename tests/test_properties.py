@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 import patrolsb3
 from patrolsb3.core import action_mask, load_map, make_config, reset_state, step
 from patrolsb3.core.maps import OBSTACLE, STATION
+from patrolsb3.core.protocol import MESSAGE_PHASE
 from patrolsb3.core.state import ABSENT, ACTIVE, FAILED, SWAPPING
 
 STRESS = dict(b_max=60.0, swap_time=(3, 8), p_dyn_max=0.3, episode_steps=10**6)
@@ -69,7 +70,9 @@ def check_invariants(spec, cfg, state, info):
     assert (state.swap_left[state.status == SWAPPING] <= cfg.swap_time[1]).all()
     assert (info.reward[~info.acted] == 0).all()
     assert (info.collisions <= info.collided.sum(axis=1)).all()
-    assert (info.collided.sum(axis=1) >= 2 * info.collisions).all()
+    # every event involves two agents or more; one agent can be in two swapped pairs only when
+    # the other two stand together on a station and both head for its cell (seed 8001, map A)
+    assert (info.collided.sum(axis=1) >= 2 * (info.collisions > 0)).all()
 
 
 @pytest.mark.parametrize("map_name", ["A", "B", "C", "D"])
@@ -121,6 +124,7 @@ def test_batched_core_equals_the_pettingzoo_env_step_for_step(map_name, comm):
     cfg = make_config(map_name, **overrides)
     env = patrolsb3.parallel_env(map_name, n_agents=4, **overrides)
     obs, infos = env.reset(seed=123)
+    team = list(env.agents)                            # the 4 deployed slots
     state = reset_state(spec, cfg, 4, n_envs=1, seed=123)
     rng = np.random.default_rng(0)
     A = cfg.max_agents
@@ -128,17 +132,17 @@ def test_batched_core_equals_the_pettingzoo_env_step_for_step(map_name, comm):
     while env.agents:
         assert np.array_equal(env.core_state.pos, state.pos)
         symbols = np.zeros(A, dtype=np.int64)
-        if infos["drone_0"]["phase"] == "message":
+        if infos["drone_0"]["phase"] == MESSAGE_PHASE:
             actions = {}
-            for i, a in enumerate(env.possible_agents):
+            for i, a in enumerate(env.agents):
                 allowed = np.flatnonzero(infos[a]["action_mask"][0])
                 actions[a] = (int(rng.choice(allowed)), 4)
                 symbols[i] = actions[a][0] + 1 if state.status[0, i] == ACTIVE else 0
             obs, rewards, terms, truncs, infos = env.step(actions)
         mask = action_mask(spec, state)[0]
-        moves = np.zeros(A, dtype=np.int64)
+        moves = np.full(A, 4, dtype=np.int64)          # slots beyond the team: Stay
         actions = {}
-        for i, a in enumerate(env.possible_agents):
+        for i, a in enumerate(env.agents):
             assert list(infos[a]["action_mask"][1]) == list(mask[i].astype(np.int8))
             moves[i] = rng.choice(np.flatnonzero(mask[i]))
             actions[a] = (0, int(moves[i]))
@@ -150,13 +154,14 @@ def test_batched_core_equals_the_pettingzoo_env_step_for_step(map_name, comm):
         assert np.array_equal(env.core_state.status, state.status)
         assert np.array_equal(env.core_state.battery, state.battery)
         assert np.array_equal(env.core_state.idle, state.idle)
-        assert [rewards[a] for a in env.possible_agents] == list(info.reward[0])
-        assert [infos[a]["collided"] for a in env.possible_agents] == list(info.collided[0])
-        grid = np.stack([obs[a]["grid"] for a in env.possible_agents])
+        assert [rewards[a] for a in team] == list(info.reward[0, :len(team)])
+        assert (info.reward[0, len(team):] == 0).all()
+        assert [infos[a]["collided"] for a in team] == list(info.collided[0, :len(team)])
+        grid = np.stack([obs[a]["grid"] for a in team])
         shown = state.copy()
         if comm != "none":
             shown.messages[:] = 0          # same-step symbols are cleared after the move phase
-        assert np.array_equal(grid, patrolsb3.core.actor_observation(spec, cfg, shown)[0][0])
+        assert np.array_equal(grid, patrolsb3.core.actor_observation(spec, cfg, shown)[0][0, :len(team)])
         if any(terms.values()):
             break
     assert n_sim_steps >= 50 and events > 0

@@ -7,6 +7,7 @@ import time
 import numpy as np
 
 from ..core import action_mask, load_map, make_config, reset_state, step
+from ..core.protocol import MOVE_PHASE
 from ..env import parallel_env
 
 
@@ -42,7 +43,7 @@ def pettingzoo_steps_per_s(map_name="A", n_agents=5, n_steps=1000, seed=0) -> fl
                               int(random_valid_moves(move_mask.astype(bool), rng)))
         phase = infos[env.agents[0]]["phase"]
         obs, rewards, terms, truncs, infos = env.step(actions)
-        sim_steps += phase == "move"
+        sim_steps += phase == MOVE_PHASE
         if not env.agents:
             obs, infos = env.reset()
     return n_steps / (time.perf_counter() - start)
