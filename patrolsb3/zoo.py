@@ -105,6 +105,16 @@ class ZooPolicy:
         self.layout = protocol.ObservationLayout.of(spec, cfg)
         self.recurrent = hasattr(policy, "lstm_actor")
 
+    SETTINGS = ("max_agents", "comm", "message_timing", "n_symbols", "local_idleness", "message_encoding",
+                "return_guard")
+    """The EnvConfig fields an env must share with the policy: its observations, actions, phases
+    and, for the entries behind the return guard, the shield on its masks."""
+
+    def env_settings(self) -> dict:
+        """The env settings this policy acts under: ``patrolsb3.parallel_env(map, n_agents,
+        **policy.env_settings())`` builds a PettingZoo env it can act in."""
+        return {key: getattr(self.cfg, key) for key in self.SETTINGS}
+
     def act_phase(self, sim_state, phase: int, lstm, starts, deterministic: bool = True):
         """One phase's actions for every slot of ``sim_state``.
 

@@ -14,3 +14,12 @@ def test_train_map_a_example_trains_and_writes_a_run_folder(tmp_path):
     for name in ("model.zip", "config.yml", "command.txt"):
         assert (run / name).is_file(), name
     assert "examples/train_map_a.py" in (run / "command.txt").read_text()
+
+
+def test_zoo_in_pettingzoo_example_prints_metrics_and_writes_a_gif(tmp_path):
+    gif = tmp_path / "episode.gif"
+    proc = subprocess.run([sys.executable, str(ROOT / "examples" / "zoo_in_pettingzoo.py"), "--steps", "20",
+                           "--gif", str(gif)], capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert "zoo:rl-msg: AVG^h" in proc.stdout and "CR: AVG^h" in proc.stdout
+    assert gif.stat().st_size > 1000
