@@ -8,21 +8,28 @@ ranked: fewest battery failures first, then the lowest AVG^h.
 """
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
 
 
 def run_checkpoints(run_dir) -> list[Path]:
-    """Every ``checkpoints/model_<steps>_steps.zip`` of a run, by steps, then ``model.zip``
-    unless a checkpoint already holds its steps (a finished run saves both).
+    """Every valid ``checkpoints/model_<steps>_steps.zip`` of a run, by steps, then ``model.zip``
+    unless a checkpoint already holds its steps (a finished run saves both); empty, cut or
+    corrupt checkpoints are named on stderr and left out.
 
     Raises:
         FileNotFoundError: a folder with no checkpoint and no model.zip.
     """
-    from .sb3.train import checkpoints_by_steps, model_steps
+    from .sb3.train import checkpoints_by_steps, is_valid_model_file, model_steps
     run_dir = Path(run_dir)
-    paths = checkpoints_by_steps(run_dir)
+    paths = []
+    for path in checkpoints_by_steps(run_dir):
+        if is_valid_model_file(path):
+            paths.append(path)
+        else:
+            print(f"skipped {path} (empty, cut or corrupt)", file=sys.stderr)
     if (run_dir / "model.zip").is_file() and model_steps(run_dir / "model.zip") not in map(model_steps, paths):
         paths.append(run_dir / "model.zip")
     if not paths:

@@ -231,3 +231,29 @@ def test_mix_runs_some_parallel_episodes_with_other_env_settings(tmp_path):
             train(map=ROOM, variant="rl-msg", timesteps=400, out=tmp_path, run_id="bad",
                   hyperparams=tiny_hp(n_envs=4, mix=bad), progress_bar=False)
         assert not (tmp_path / "room" / "rl-msg" / "bad").exists()    # fix it and run the same command
+
+
+def test_resume_passes_over_empty_and_corrupt_checkpoints(tmp_path, capsys):
+    """A run killed while writing a checkpoint leaves an empty or cut file; one with flipped
+    bytes fails its CRC: --resume (and zoo export / validate) use the newest valid one, say
+    which they passed over, and the writes themselves go through a temporary name."""
+    from patrolsb3.checkpoints import run_checkpoints
+    from patrolsb3.sb3.train import is_valid_model_file
+    run = train(map=ROOM, timesteps=800, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
+    good = newest_checkpoint(run)
+    assert good.name == "model_800_steps.zip" and is_valid_model_file(good)
+    assert not list((run / "checkpoints").glob(".*partial*"))          # no temporary file left
+    (run / "checkpoints" / "model_1200_steps.zip").write_bytes(b"")    # killed at the start of a write
+    flipped = bytearray(good.read_bytes())
+    flipped[len(flipped) // 2] ^= 0xFF
+    (run / "checkpoints" / "model_1600_steps.zip").write_bytes(bytes(flipped))
+    cut = good.read_bytes()[: len(flipped) // 3]
+    (run / "checkpoints" / "model_2000_steps.zip").write_bytes(cut)
+    skipped = []
+    assert newest_checkpoint(run, skipped) == good
+    assert [p.name for p in skipped] == ["model_2000_steps.zip", "model_1600_steps.zip", "model_1200_steps.zip"]
+    assert good in run_checkpoints(run) and not any(p.name == "model_1600_steps.zip" for p in run_checkpoints(run))
+    train(map=ROOM, timesteps=2400, out=tmp_path, hyperparams=tiny_hp(), resume=True, progress_bar=False)
+    err = capsys.readouterr().err
+    assert "skipped" in err and "model_1600_steps.zip" in err
+    assert MaskableRecurrentPPO.load(run / "model.zip", device="cpu").num_timesteps == 2400

@@ -18,6 +18,7 @@ in the hyperparameters and converted per env step (``gamma ** (1 / phases_per_st
 from __future__ import annotations
 
 import json
+import os
 import re
 import sys
 import zipfile
@@ -25,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 import yaml
+from stable_baselines3.common.callbacks import CheckpointCallback
 from stable_baselines3.common.vec_env import VecNormalize
 
 from .algorithms import DEFAULT_ALGORITHM, get_algorithm, torch_device
@@ -70,10 +72,63 @@ def model_steps(model_path) -> int | None:
         return None
 
 
-def newest_checkpoint(run_dir: Path) -> Path | None:
-    """The checkpoint of ``run_dir/checkpoints`` with the most timesteps, or None."""
-    found = checkpoints_by_steps(run_dir)
-    return found[-1] if found else None
+def is_valid_model_file(path) -> bool:
+    """True for a readable SB3 zip: not empty, every member's CRC right, a ``data`` record (a
+    run killed while writing leaves an empty or cut file; flipped bytes fail the CRC)."""
+    path = Path(path)
+    try:
+        if path.stat().st_size == 0:
+            return False
+        with zipfile.ZipFile(path) as archive:
+            return archive.testzip() is None and "data" in archive.namelist()
+    except (OSError, zipfile.BadZipFile, EOFError):
+        return False
+
+
+def newest_checkpoint(run_dir: Path, skipped: list | None = None) -> Path | None:
+    """The valid checkpoint of ``run_dir/checkpoints`` with the most timesteps, or None.
+
+    Args:
+        skipped: a list that receives the newer checkpoints passed over as invalid.
+    """
+    for path in reversed(checkpoints_by_steps(run_dir)):
+        if is_valid_model_file(path):
+            return path
+        if skipped is not None:
+            skipped.append(path)
+    return None
+
+
+def save_atomically(model, path) -> Path:
+    """``model.save`` under a temporary name beside ``path``, then a rename: a kill during the
+    write leaves no file with the checkpoint's name."""
+    path = Path(path)
+    partial = path.with_name(f".{path.stem}.partial.zip")
+    model.save(partial)
+    os.replace(partial, path)
+    return path
+
+
+def save_statistics_atomically(vec_normalize, path) -> Path:
+    """``VecNormalize.save`` the same way (temporary name, then a rename)."""
+    path = Path(path)
+    partial = path.with_name(f".{path.name}.partial")
+    vec_normalize.save(str(partial))
+    os.replace(partial, path)
+    return path
+
+
+class AtomicCheckpointCallback(CheckpointCallback):
+    """SB3's CheckpointCallback with atomic writes: the reward statistics first, then the model
+    (a checkpoint whose model file exists has its statistics)."""
+
+    def _on_step(self) -> bool:
+        if self.n_calls % self.save_freq == 0:
+            normalize = self.model.get_vec_normalize_env()
+            if self.save_vecnormalize and normalize is not None:
+                save_statistics_atomically(normalize, self._checkpoint_path("vecnormalize_", extension="pkl"))
+            save_atomically(self.model, self._checkpoint_path(extension="zip"))
+        return True
 
 
 def run_folder_of(model_path: Path) -> Path:
@@ -167,10 +222,14 @@ def normalized_rewards(vec_env, checkpoint: Path | None, gamma: float):
 
 
 def _check_resumable(run_dir: Path, config: dict) -> Path:
-    """The newest checkpoint of a run folder whose config matches this run's map and env."""
-    checkpoint = newest_checkpoint(run_dir)
+    """The newest valid checkpoint of a run folder whose config matches this run's map and env
+    (newer invalid ones are named on stderr and passed over)."""
+    skipped = []
+    checkpoint = newest_checkpoint(run_dir, skipped)
+    for path in skipped:
+        print(f"--resume: skipped {path} (empty, cut or corrupt)", file=sys.stderr)
     if checkpoint is None:
-        raise FileNotFoundError(f"--resume: no checkpoint found in {run_dir / 'checkpoints'} "
+        raise FileNotFoundError(f"--resume: no valid checkpoint found in {run_dir / 'checkpoints'} "
                                 f"(looked for model_<steps>_steps.zip)")
     saved_file = run_dir / "config.yml"
     if saved_file.is_file():
@@ -309,7 +368,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
         FileNotFoundError: ``resume`` without a checkpoint (names where it looked).
     """
     import torch
-    from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
+    from stable_baselines3.common.callbacks import CallbackList
 
     from ..core.maps import load_map
     from .callbacks import LearningCurveCallback, PaperMetricsEvalCallback
@@ -390,7 +449,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
                             strict=spec.masked, **eval_env_kwargs)
 
     cpu_time = CpuTimeCallback(run_dir, restart_at(run_dir, model.num_timesteps) if checkpoint is not None else 0.0)
-    callbacks = [cpu_time, CheckpointCallback(save_freq=max(1, int(hp.get("checkpoint_freq", 200_000)) // rows),
+    callbacks = [cpu_time, AtomicCheckpointCallback(save_freq=max(1, int(hp.get("checkpoint_freq", 200_000)) // rows),
                                     save_path=str(run_dir / "checkpoints"), name_prefix="model",
                                     save_vecnormalize=True),
                  LearningCurveCallback(run_dir / "curve.csv", max_agents),
@@ -403,10 +462,10 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
             model.learn(remaining, callback=CallbackList(callbacks), reset_num_timesteps=checkpoint is None,
                         progress_bar=progress_bar, tb_log_name=spec.name)
     finally:
-        model.save(run_dir / "checkpoints" / f"model_{model.num_timesteps}_steps.zip")
-        cpu_time.record(model.num_timesteps)
         if isinstance(vec_env, VecNormalize):
-            vec_env.save(str(run_dir / "checkpoints" / VECNORMALIZE_FILE.format(model.num_timesteps)))
+            save_statistics_atomically(vec_env, run_dir / "checkpoints" / VECNORMALIZE_FILE.format(model.num_timesteps))
+        save_atomically(model, run_dir / "checkpoints" / f"model_{model.num_timesteps}_steps.zip")
+        cpu_time.record(model.num_timesteps)
         vec_env.close()
-    model.save(run_dir / "model.zip")
+    save_atomically(model, run_dir / "model.zip")
     return run_dir
