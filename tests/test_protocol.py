@@ -140,3 +140,9 @@ def test_protocol_signature_separates_what_changes_the_spaces():
     for change in ({"local_idleness": True}, {"comm": "none"}, {"max_agents": 4},
                    {"message_timing": "delayed"}, {"message_encoding": "planes"}):
         assert protocol.protocol_signature(base) != protocol.protocol_signature(make_config(**change))
+
+
+@pytest.mark.parametrize("bad", [2.5, "3", True])
+def test_check_team_refuses_what_is_not_a_whole_number(spec, bad):
+    with pytest.raises(ValueError, match="n_agents must be a whole number"):
+        protocol.check_team(spec, make_config(), bad)

@@ -193,5 +193,5 @@ def test_home_shaping_pays_back_the_trip_on_arrival_and_nothing_on_failure(line_
 
 
 def test_a_negative_home_shaping_weight_is_refused():
-    with pytest.raises(ValueError, match="c_home must be >= 0, got -1"):
+    with pytest.raises(ValueError, match="c_home must be a finite number >= 0, got -1"):
         make_config(c_home=-1.0)

@@ -92,6 +92,7 @@ def test_rows_are_the_protocol_view_of_the_batched_state(spec, variant):
                           "t", "n_agents"):
                 setattr(pz.core_state, field, getattr(state, field)[e:e + 1].copy())
             pz._decide(phase)
+            pz.agents = list(pz.possible_agents)     # view every slot, padding included
             for s_, name in enumerate(pz.possible_agents):
                 o = pz._observations()[name]
                 np.testing.assert_array_equal(venv.layout.flatten(o["grid"], o["vector"], o["critic"]),

@@ -5,7 +5,10 @@ Defaults follow the paper and ``SPEC.md``; unknown keys are refused loudly.
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Optional
+
+import numpy as np
 
 ENV_VERSION = "patrol_v1"
 """Version of the environment's rules; checkpoints record it and refuse a mismatch."""
@@ -14,6 +17,33 @@ COMM_MODES = ("none", "learned", "intention")
 MESSAGE_TIMINGS = ("same_step", "delayed")
 MESSAGE_ENCODINGS = ("scalar", "planes")
 INVALID_ACTION_MODES = ("raise", "stay")
+
+BOOL_FIELDS = ("return_guard", "local_idleness")
+INT_FIELDS = {"max_agents": 1, "episode_steps": 1, "n_symbols": 1}
+"""Integer fields and their smallest value (a fractional or boolean value is refused)."""
+NUMBER_RANGES = {"b_max": (1e-9, math.inf), "step_minutes": (1e-9, math.inf), "c_norm": (1e-9, math.inf),
+                 "push_drain_factor": (0.0, math.inf), "p_dyn_max": (0.0, 1.0), "fault_prob": (0.0, 1.0),
+                 "b_low_frac": (0.0, 1.0), "c_rp": (0.0, math.inf), "c_pb": (0.0, math.inf),
+                 "c_pbb": (0.0, math.inf), "c_pbm": (0.0, math.inf), "c_pc": (0.0, math.inf),
+                 "c_home": (0.0, math.inf)}
+"""Number fields and their closed range: finite, and > 0 where a zero would divide or empty
+the battery (b_max, c_norm, step_minutes)."""
+PAIR_RANGES = {"init_battery": (0.0, 1.0), "drain": (0.0, math.inf), "swap_time": (1.0, math.inf)}
+"""(low, high) fields: each end in this range and low <= high (a drain below 0 would charge)."""
+
+
+def _check_number(name: str, value, low: float, high: float) -> None:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{name} must be a number, got {value!r}")
+    if not math.isfinite(value) or not low <= value <= high:
+        bound = f">= {low:g}" if high == math.inf else f"in [{low:g}, {high:g}]"
+        raise ValueError(f"{name} must be a finite number {'> 0' if low == 1e-9 else bound}, got {value!r}")
+
+
+def _check_int(name: str, value, low: int) -> None:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < low:
+        raise ValueError(f"{name} must be a whole number >= {low}, got {value!r}")
+
 
 # Per-map parameter changes taken from the paper (c_pbb is 0.5 on map B).
 MAP_OVERRIDES = {"B": {"c_pbb": 0.5}}
@@ -108,25 +138,39 @@ class EnvConfig:
     """What a masked (invalid) move does: 'raise' an error or be treated as 'stay'."""
 
     def __post_init__(self):
-        if self.max_agents < 1:
-            raise ValueError(f"max_agents must be >= 1, got {self.max_agents}")
-        if self.comm not in COMM_MODES:
-            raise ValueError(f"comm must be one of {COMM_MODES}, got {self.comm!r}")
-        if self.message_timing not in MESSAGE_TIMINGS:
-            raise ValueError(f"message_timing must be one of {MESSAGE_TIMINGS}, got {self.message_timing!r}")
-        if self.message_encoding not in MESSAGE_ENCODINGS:
-            raise ValueError(f"message_encoding must be one of {MESSAGE_ENCODINGS}, got {self.message_encoding!r}")
-        if self.invalid_action not in INVALID_ACTION_MODES:
-            raise ValueError(f"invalid_action must be one of {INVALID_ACTION_MODES}, got {self.invalid_action!r}")
-        if self.c_home < 0:
-            raise ValueError(f"c_home must be >= 0, got {self.c_home}")
-        if self.episode_steps < 1:
-            raise ValueError(f"episode_steps must be >= 1, got {self.episode_steps}")
-        if not 0.0 <= self.p_dyn_max <= 1.0:
-            raise ValueError(f"p_dyn_max must be in [0, 1], got {self.p_dyn_max}")
-        if self.swap_time[0] < 1 or self.swap_time[1] < self.swap_time[0]:
-            raise ValueError(f"swap_time must be (low, high) with 1 <= low <= high, got {self.swap_time}")
-        object.__setattr__(self, "faults", tuple(tuple(int(v) for v in f) for f in self.faults))
+        for name, allowed in (("comm", COMM_MODES), ("message_timing", MESSAGE_TIMINGS),
+                              ("message_encoding", MESSAGE_ENCODINGS), ("invalid_action", INVALID_ACTION_MODES)):
+            if getattr(self, name) not in allowed:
+                raise ValueError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
+        for name in BOOL_FIELDS:
+            if not isinstance(getattr(self, name), (bool, np.bool_)):
+                raise ValueError(f"{name} must be true or false, got {getattr(self, name)!r}")
+        for name, low in INT_FIELDS.items():
+            _check_int(name, getattr(self, name), low)
+        for name, (low, high) in NUMBER_RANGES.items():
+            _check_number(name, getattr(self, name), low, high)
+        if self.c_d is not None:
+            _check_number("c_d", self.c_d, 0.0, math.inf)
+        for name, (low, high) in PAIR_RANGES.items():
+            pair = getattr(self, name)
+            if not isinstance(pair, (tuple, list)) or len(pair) != 2:
+                raise ValueError(f"{name} must be a pair (low, high), got {pair!r}")
+            for value in pair:
+                _check_number(name, value, low, high)
+            if pair[0] > pair[1]:
+                raise ValueError(f"{name} must be (low, high) with low <= high, got {tuple(pair)}")
+        for value in self.swap_time:
+            _check_int("swap_time", value, 1)
+        try:
+            faults = tuple(tuple(f) for f in self.faults)
+        except TypeError:
+            raise ValueError(f"faults must be (step, k) pairs, got {self.faults!r}") from None
+        for fault in faults:
+            if len(fault) != 2:
+                raise ValueError(f"faults must be (step, k) pairs, got {fault!r}")
+            _check_int("faults step", fault[0], 0)
+            _check_int("faults k", fault[1], 1)
+        object.__setattr__(self, "faults", tuple(tuple(int(v) for v in f) for f in faults))
 
     @property
     def two_phase(self) -> bool:

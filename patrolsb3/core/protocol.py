@@ -65,6 +65,8 @@ def check_team(spec: MapSpec, cfg: EnvConfig, n_agents) -> int:
     Raises:
         ValueError: names the team size and the limit it breaks.
     """
+    if isinstance(n_agents, (bool, np.bool_)) or not isinstance(n_agents, (int, np.integer)):
+        raise ValueError(f"n_agents must be a whole number, got {n_agents!r}")
     if not 1 <= int(n_agents) <= cfg.max_agents:
         raise ValueError(f"n_agents={n_agents} must be between 1 and max_agents={cfg.max_agents}")
     if int(n_agents) > spec.n_vertices:
