@@ -25,7 +25,10 @@ COMMANDS = {
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every sub-command registered."""
     from . import __version__
-    parser = argparse.ArgumentParser(prog="patrolsb3", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(
+        prog="patrolsb3", description="Multi-agent drone patrolling (the paper's model, heuristics, "
+                                      "SB3 training and a model zoo). One sub-command per job; "
+                                      "'patrolsb3 COMMAND --help' for its options.")
     parser.add_argument("--version", action="version", version=f"patrolsb3 {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, help_text in COMMANDS.items():

@@ -28,7 +28,7 @@ phase): ``collided``, ``collisions`` (events), ``pushed``, ``swap_started``, ``s
 
 
 class PatrolParallelEnv(ParallelEnv):
-    """Multi-drone patrolling of a grid map (the paper's model, SPEC.md sections 1-5).
+    """Multi-drone patrolling of a grid map (the paper's model, docs/model.md, sections 1-5).
 
     Agents: the team, ``drone_0 .. drone_{n_agents-1}`` (``possible_agents`` lists every slot
     up to ``max_agents``); they stay in ``agents`` for the whole episode. A swapping or failed

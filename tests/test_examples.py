@@ -23,3 +23,11 @@ def test_zoo_in_pettingzoo_example_prints_metrics_and_writes_a_gif(tmp_path):
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert "zoo:rl-msg: AVG^h" in proc.stdout and "CR: AVG^h" in proc.stdout
     assert gif.stat().st_size > 1000
+
+
+def test_compare_map_a_example_writes_the_report(tmp_path):
+    proc = subprocess.run([sys.executable, str(ROOT / "examples" / "compare_map_a.py"), "--agents", "1-2",
+                           "--episodes", "1", "--steps", "30", "--out", str(tmp_path / "cmp")],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert (tmp_path / "cmp" / "report.md").is_file() and (tmp_path / "cmp" / "A.png").is_file()

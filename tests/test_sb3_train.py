@@ -257,3 +257,9 @@ def test_resume_passes_over_empty_and_corrupt_checkpoints(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "skipped" in err and "model_1600_steps.zip" in err
     assert MaskableRecurrentPPO.load(run / "model.zip", device="cpu").num_timesteps == 2400
+
+
+def test_a_run_on_a_shipped_map_records_no_path_of_this_machine(tmp_path):
+    run = train(map="A", timesteps=400, out=tmp_path, hyperparams=tiny_hp(n_envs=1), progress_bar=False)
+    config = yaml.safe_load((run / "config.yml").read_text())
+    assert config["map_source"] == "maps/map_a.txt"

@@ -1,6 +1,6 @@
 """Every parameter of the patrolling environment in one frozen dataclass.
 
-Defaults follow the paper and ``SPEC.md``; unknown keys are refused loudly.
+Defaults follow the paper and ``docs/model.md``; unknown keys are refused loudly.
 """
 from __future__ import annotations
 

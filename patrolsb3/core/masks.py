@@ -38,7 +38,7 @@ def _blocked(spec: MapSpec, state: State, target: np.ndarray) -> np.ndarray:
 
 def return_threshold(spec: MapSpec, cfg) -> np.ndarray:
     """Battery at or below which an agent on each cell must head for the station: the
-    heuristics' recharge rule (SPEC.md section 6), so that it arrives with about ``b_l`` left.
+    heuristics' recharge rule (docs/model.md, section 6), so that it arrives with about ``b_l`` left.
 
         threshold(cell) = steps_home(cell) * drain_high * push_factor_margin + b_l
         push_factor_margin = (1 + p_dyn_max (push_drain_factor - 1))   # pushed steps drain more

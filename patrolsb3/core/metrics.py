@@ -1,4 +1,4 @@
-"""Per-episode accumulators of the paper's metrics over a batch of episodes (SPEC.md section 5).
+"""Per-episode accumulators of the paper's metrics over a batch of episodes (docs/model.md, section 5).
 
 Feed :meth:`EpisodeMetrics.update` the state and the ``StepInfo`` after every step. Idleness
 is the simulator's ``state.idle`` after the step (0 at t = 0, rate-weighted). Over h steps:

@@ -1,4 +1,4 @@
-"""Actor observations and the centralised critic state (SPEC.md section 3).
+"""Actor observations and the centralised critic state (docs/model.md, section 3).
 
 Grid channel 0 (positions and messages), values divided by ``n_symbols + 2``:
 

@@ -1,4 +1,4 @@
-"""One simulator step for a batch of episodes, in the order of SPEC.md section 2:
+"""One simulator step for a batch of episodes, in the order of docs/model.md, section 2:
 
 messages -> moves (checked against the mask) -> pushes -> collisions -> battery drain ->
 idleness -> hot swaps -> failures -> rewards.
@@ -17,7 +17,7 @@ Documented choices (where the paper is silent):
 * A swap starts when an agent's own (not pushed) move takes it onto a station from another
   cell; it lasts ``swap_time`` steps, offline; at the end of the last of them a fresh agent
   (full battery) appears on that station. Arriving on purpose saves an agent whose battery
-  ran out on the same step (the swap comes before the failure check, as in SPEC order).
+  ran out on the same step (the swap comes before the failure check, as in the order of docs/model.md, section 2).
 * Faults: ``faults=((s, k), ...)`` makes k agents that exist (active or swapping, chosen at
   random) fail at the end of step s (0-based); ``fault_prob`` fails each active agent with
   that probability per step.

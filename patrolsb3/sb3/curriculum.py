@@ -1,4 +1,4 @@
-"""The paper's curriculum of team sizes (SPEC.md section 7) and its learning-rate drop."""
+"""The paper's curriculum of team sizes (docs/model.md, section 7) and its learning-rate drop."""
 from __future__ import annotations
 
 from typing import Callable

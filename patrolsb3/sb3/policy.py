@@ -1,4 +1,4 @@
-"""The paper's actor and critic networks as SB3 policies (SPEC.md section 7).
+"""The paper's actor and critic networks as SB3 policies (docs/model.md, section 7).
 
 Observation rows of :func:`patrolsb3.sb3.make_vec_env` are flat vectors
 ``[grid (2, H, W) flattened, vector (15), critic (3 * max_agents)]``. Each network is

@@ -137,6 +137,16 @@ def run_folder_of(model_path: Path) -> Path:
     return model_path.parent.parent if model_path.parent.name == "checkpoints" else model_path.parent
 
 
+def map_source(spec) -> str:
+    """Where a run's map came from, as config.yml records it: ``maps/map_<x>.txt`` for a shipped
+    map (no path of this machine), else the path given."""
+    from ..core.maps import MAPS_DIR
+    source = Path(str(spec.source))
+    if source.is_file() and source.resolve().parent == MAPS_DIR.resolve():
+        return f"maps/{source.name}"
+    return str(spec.source)
+
+
 def versions() -> dict:
     """Versions of the packages a checkpoint depends on."""
     import sb3_contrib
@@ -397,7 +407,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
 
     run_dir = Path(run_dir) if run_dir is not None else \
         Path(out) / spec_map.name / variant / (run_id or f"{spec.name}_seed{seed}")
-    config = {"map": spec_map.name, "map_source": str(spec_map.source), "map_shape": list(spec_map.shape),
+    config = {"map": spec_map.name, "map_source": map_source(spec_map), "map_shape": list(spec_map.shape),
               "variant": variant, "algo": spec.name, "seed": int(seed), "timesteps": total,
               "env": cfg.to_dict(), "hyperparams": hp, "versions": versions()}
     checkpoint = None

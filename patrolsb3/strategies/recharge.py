@@ -1,4 +1,4 @@
-"""The recharge planner every heuristic shares (SPEC.md section 6).
+"""The recharge planner every heuristic shares (docs/model.md, section 6).
 
 Rule: an active agent heads for its nearest charging station as soon as its battery is at or
 below :func:`patrolsb3.core.masks.return_threshold` for its cell,
