@@ -27,12 +27,10 @@ SECONDS_PER_CALL=${2:?usage: zoo/train_paper_setting.sh 1|2 SECONDS [--resume]}
 RESUME=${3:-}
 RUNS=${RUNS:-"A:rl-msg:0 A:rl-no-msg:0"}
 OUT=${OUT:-runs/paper}
-SHARED="normalize_reward=true gamma=0.99 batch_size=2048 env.local_idleness=true env.c_d=200 env.message_encoding=planes"
+# the settings of each stage: the recipes zoo-stage1 and zoo-stage2 (patrolsb3/sb3/recipes.py)
 case "$STAGE" in
-  1) SIM=${SIM_STEPS:-25000}
-     SET="env.episode_steps=300 env.init_battery=[1.0,1.0] $SHARED learning_rate=drop_6e-4_3e-4" ;;
-  2) SIM=${SIM_STEPS:-200000}
-     SET="env.episode_steps=1500 env.init_battery=[0.15,1.0] mix.episodes=[0,2,4,6] mix.env.episode_steps=400 mix.env.init_battery=[0.05,0.4] env.c_home=50 $SHARED learning_rate=3e-4 curriculum=false" ;;
+  1) SIM=${SIM_STEPS:-25000} ;;
+  2) SIM=${SIM_STEPS:-200000} ;;
   *) echo "stage must be 1 or 2" >&2; exit 2 ;;
 esac
 mkdir -p "$OUT/logs"
@@ -44,7 +42,7 @@ for run in $RUNS; do
   if [ "$STAGE" = 2 ] && [ -z "$RESUME" ]; then init=(--init-from "$OUT/stage1/$map/$variant/seed$seed"); fi
   nohup timeout -s INT "$SECONDS_PER_CALL" patrolsb3 train --map "$map" --variant "$variant" --seed "$seed" \
     --timesteps "$timesteps" --out "$OUT/stage$STAGE" --run-id "seed$seed" $RESUME "${init[@]}" \
-    --device cpu --no-progress --checkpoint-freq 500000 --eval-freq 0 --set $SET \
+    --device cpu --no-progress --checkpoint-freq 500000 --eval-freq 0 --recipe "zoo-stage$STAGE" \
     >> "$OUT/logs/stage${STAGE}_${map}_${variant}_seed${seed}.log" 2>&1 &
 done
 wait

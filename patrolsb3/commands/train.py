@@ -15,6 +15,9 @@ def add_arguments(parser):
     parser.add_argument("--init-from", default=None, metavar="MODEL",
                         help="start a new run from the policy weights of a checkpoint, run folder or zoo entry")
     parser.add_argument("--hyperparams", default=None, help="YAML keyed by map with a default: entry")
+    parser.add_argument("--recipe", default="paper",
+                        help="named overrides on top of the YAML: paper (default: its values), zoo-stage1, "
+                             "zoo-stage2 (patrolsb3/sb3/recipes.py); --set applies on top")
     parser.add_argument("--set", nargs="+", action="extend", default=[], metavar="KEY=VALUE",
                         help="override hyperparameters, e.g. n_steps=128 policy_kwargs.lstm_hidden_size=64 "
                              "env.episode_steps=1000")
@@ -29,10 +32,12 @@ def add_arguments(parser):
 def run(args):
     import sys
 
-    from ..sb3.hyperparams import parse_set
+    from ..sb3.hyperparams import merge, parse_set
+    from ..sb3.recipes import recipe
     from ..sb3.train import train
+    overrides = merge(recipe(args.recipe), parse_set(args.set))
     run_dir = train(map=args.map, variant=args.variant, timesteps=args.timesteps, out=args.out, algo=args.algo,
-                    seed=args.seed, resume=args.resume, init_from=args.init_from, hyperparams=parse_set(args.set),
+                    seed=args.seed, resume=args.resume, init_from=args.init_from, hyperparams=overrides,
                     hyperparams_file=args.hyperparams, eval_freq=args.eval_freq,
                     checkpoint_freq=args.checkpoint_freq, progress_bar=not args.no_progress,
                     verbose=args.verbose, run_id=args.run_id, command="patrolsb3 " + " ".join(sys.argv[1:]),

@@ -38,6 +38,10 @@ class LearningCurveCallback(BaseCallback):
         super().__init__(verbose)
         self.path = Path(path)
         self.max_agents = int(max_agents)
+        self.rows_written = 0
+
+    def _on_training_start(self) -> None:
+        append_rows(self.path, CURVE_FIELDS, [])    # the file exists (header) before any episode ends
 
     def _on_step(self) -> bool:
         dones, infos = self.locals["dones"], self.locals["infos"]
@@ -50,6 +54,7 @@ class LearningCurveCallback(BaseCallback):
             rows.append({"timesteps": self.num_timesteps, **infos[row]["team_episode"]})
         if rows:
             append_rows(self.path, CURVE_FIELDS, rows)
+            self.rows_written += len(rows)
             for key in ("reward", "mean_idleness", "max_idleness"):
                 self.logger.record_mean(f"team/{key}", float(np.mean([r[key] for r in rows])))
         return True

@@ -458,11 +458,12 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
         return make_vec_env(spec_map, agents=eval_teams, variant=variant, seed=seed + 10_000,
                             strict=spec.masked, **eval_env_kwargs)
 
+    curve = LearningCurveCallback(run_dir / "curve.csv", max_agents)
     cpu_time = CpuTimeCallback(run_dir, restart_at(run_dir, model.num_timesteps) if checkpoint is not None else 0.0)
     callbacks = [cpu_time, AtomicCheckpointCallback(save_freq=max(1, int(hp.get("checkpoint_freq", 200_000)) // rows),
                                     save_path=str(run_dir / "checkpoints"), name_prefix="model",
                                     save_vecnormalize=True),
-                 LearningCurveCallback(run_dir / "curve.csv", max_agents),
+                 curve,
                  PaperMetricsEvalCallback(make_eval_env, run_dir / "eval.csv", int(hp.get("eval_freq", 0)))]
     if hp.get("curriculum", True):
         callbacks.insert(0, CurriculumCallback(total, curriculum=teams))
@@ -478,4 +479,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
         cpu_time.record(model.num_timesteps)
         vec_env.close()
     save_atomically(model, run_dir / "model.zip")
+    if curve.rows_written == 0 and remaining > 0:
+        print(f"curve.csv: no episode finished in these {remaining:,} agent-steps (episodes last "
+              f"{cfg.episode_steps:,} simulator steps); it holds its header only", file=sys.stderr)
     return run_dir
