@@ -263,3 +263,23 @@ def test_a_run_on_a_shipped_map_records_no_path_of_this_machine(tmp_path):
     run = train(map="A", timesteps=400, out=tmp_path, hyperparams=tiny_hp(n_envs=1), progress_bar=False)
     config = yaml.safe_load((run / "config.yml").read_text())
     assert config["map_source"] == "maps/map_a.txt"
+
+
+@pytest.mark.parametrize("setting, match", [
+    ("n_steps=0", "n_steps must be a whole number >= 2"), ("n_epochs=0", "n_epochs"),
+    ("batch_size=-4", "batch_size"), ("n_minibatches=0", "n_minibatches"),
+    ("learning_rate=fast", "learning_rate"), ("checkpoint_freq=0", "checkpoint_freq"),
+    ("n_epochs=[1,2", "not valid YAML"), ("gamma=x", "gamma must be a number")])
+def test_bad_settings_are_refused_before_a_run_folder_exists(tmp_path, capsys, setting, match):
+    from patrolsb3.cli import main
+    assert main(["train", "--map", "A", "--timesteps", "400", "--out", str(tmp_path), "--set", setting]) == 2
+    err = capsys.readouterr().err
+    assert match in err and len(err.strip().splitlines()) == 1
+    assert not any(tmp_path.iterdir())
+
+
+def test_tiny_rollouts_train_without_nan(tmp_path):
+    run = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(n_steps=4, n_minibatches=50),
+                progress_bar=False)
+    model = MaskableRecurrentPPO.load(run / "model.zip", device="cpu")
+    assert all(th.isfinite(p).all() for p in model.policy.parameters())

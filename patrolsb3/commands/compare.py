@@ -56,6 +56,8 @@ def run(args):
     from ..result_store import ResultStore
     from ..sb3.algorithms import torch_device
     torch_device(args.device)   # a device torch cannot use: one line, before any work
+    from ..outputs import check_output_dir
+    check_output_dir(args.out, "--out")
     if args.protocol == "paper":
         args.tests, args.episodes, args.steps = 10, 100, 14400
     maps = [m.strip() for m in args.maps.split(",") if m.strip()]

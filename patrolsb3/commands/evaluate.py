@@ -24,13 +24,18 @@ def add_arguments(parser):
 def run(args):
     from ..evaluate import evaluate, parse_faults
     from ..report import evaluation_text
+    from ..outputs import check_output_file, strict_json
     from ..sb3.algorithms import torch_device
     torch_device(args.device)   # a device torch cannot use: one line, before any work
+    if args.json:
+        check_output_file(args.json, "--json")
     result = evaluate(args.strategy, args.map, args.agents, episodes=args.episodes, tests=args.tests,
                       steps=args.steps, seed=args.seed, faults=parse_faults(args.faults),
                       progress=not args.no_progress, deterministic=not args.stochastic, device=args.device)
     print(evaluation_text(result))
     if args.json:
+        from pathlib import Path
+        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
         with open(args.json, "w") as fh:
-            json.dump(result, fh, indent=2)
+            json.dump(strict_json(result), fh, indent=2, allow_nan=False)   # NaN (no swap) -> null
     return 0

@@ -19,7 +19,10 @@ def map_summary(spec) -> dict:
 def run(args):
     from pathlib import Path
 
-    from ..core.maps import available_maps, load_map
+    from ..core.maps import available_maps, load_map, source_label
+    from ..outputs import check_output_dir
+    if args.png:
+        check_output_dir(args.png, "--png")
 
     specs = [load_map(name) for name in (args.names or available_maps())]
     columns = ("name", "size", "vertices", "stations", "priority_vertices")
@@ -30,7 +33,7 @@ def run(args):
         print("  ".join(str(r[c]).ljust(widths[c]) for c in columns))
     if not args.no_draw:
         for spec in specs:
-            print(f"\nmap {spec.name} ({spec.source})")
+            print(f"\nmap {spec.name} ({source_label(spec)})")
             print(spec.to_text())
         print("\nlegend: # obstacle, . vertex, 1-9 priority vertex (idleness rate 1+p), S station")
     if args.png:

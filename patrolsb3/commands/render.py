@@ -25,8 +25,12 @@ def run(args):
     from ..evaluate import load_policy
     from ..render import render_frame, save_gif
 
+    from ..outputs import check_output_file
     if args.steps < 1 or args.every < 1 or args.tile < 4:
         raise ValueError("--steps and --every must be >= 1 and --tile >= 4")
+    check_output_file(args.out, "--out")
+    if args.frame:
+        check_output_file(args.frame, "--frame")
     spec = load_map(args.map)
     cfg = make_config(spec.name, episode_steps=max(5000, args.steps))
     state = reset_state(spec, cfg, args.agents, n_envs=1, seed=args.seed)

@@ -284,6 +284,15 @@ def _all_pairs_bfs(free_cells, free_index, neighbour, move_ok):
     return dist, next_action
 
 
+def source_label(spec: MapSpec) -> str:
+    """Where a map came from, for config files and output: ``maps/map_<x>.txt`` for a shipped
+    map (no path of this machine), else the path it was loaded from."""
+    source = Path(str(spec.source))
+    if source.is_file() and source.resolve().parent == MAPS_DIR.resolve():
+        return f"maps/{source.name}"
+    return str(spec.source)
+
+
 def available_maps() -> list[str]:
     """Names of the maps shipped in ``maps/`` ("A", "B", ...)."""
     return sorted(p.stem[4:].upper() for p in MAPS_DIR.glob("map_*.txt"))

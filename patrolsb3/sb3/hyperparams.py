@@ -64,7 +64,11 @@ def parse_set(pairs: list[str]) -> dict:
         if "=" not in pair:
             raise ValueError(f"--set expects key=value, got {pair!r}")
         key, text = pair.split("=", 1)
-        value = yaml.safe_load(text)
+        try:
+            value = yaml.safe_load(text)
+        except yaml.YAMLError as exc:
+            problem = str(exc).splitlines()[0]
+            raise ValueError(f"--set {pair!r}: the value is not valid YAML ({problem})") from None
         parts = key.strip().split(".")
         node = out
         for part in parts[:-1]:

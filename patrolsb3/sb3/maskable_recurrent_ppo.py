@@ -83,7 +83,7 @@ class MaskableRecurrentPPO(RecurrentPPO):
         if n_minibatches is None:
             return int(self.batch_size)
         self.rollout_buffer.prepare()
-        return max(1, -(-self.rollout_buffer.n_rows // n_minibatches))
+        return max(2, -(-self.rollout_buffer.n_rows // n_minibatches))
 
     def _setup_model(self) -> None:
         super()._setup_model()
@@ -252,7 +252,7 @@ class MaskableRecurrentPPO(RecurrentPPO):
             action_masks=data.action_masks)
         values = values.flatten()
         advantages = data.advantages
-        if self.normalize_advantage:
+        if self.normalize_advantage and int(mask.sum()) > 1:   # as SB3's PPO: not over a single row
             advantages = (advantages - advantages[mask].mean()) / (advantages[mask].std() + 1e-8)
         ratio = th.exp(log_prob - data.old_log_prob)
         policy_loss_1 = advantages * ratio

@@ -137,16 +137,6 @@ def run_folder_of(model_path: Path) -> Path:
     return model_path.parent.parent if model_path.parent.name == "checkpoints" else model_path.parent
 
 
-def map_source(spec) -> str:
-    """Where a run's map came from, as config.yml records it: ``maps/map_<x>.txt`` for a shipped
-    map (no path of this machine), else the path given."""
-    from ..core.maps import MAPS_DIR
-    source = Path(str(spec.source))
-    if source.is_file() and source.resolve().parent == MAPS_DIR.resolve():
-        return f"maps/{source.name}"
-    return str(spec.source)
-
-
 def versions() -> dict:
     """Versions of the packages a checkpoint depends on."""
     import sb3_contrib
@@ -208,6 +198,31 @@ def algorithm_kwargs(hp: dict, spec, layout, phases_per_step: int, rows: int) ->
                 ent_coef=float(hp["ent_coef"]), vf_coef=float(hp["vf_coef"]),
                 max_grad_norm=float(hp["max_grad_norm"]), target_kl=hp.get("target_kl"),
                 policy_kwargs=policy_kwargs_for(layout, **policy_kwargs), **extra)
+
+
+def check_run_settings(hp: dict, total) -> None:
+    """Refuse, before any work and before the run folder exists, the settings that would fail
+    later or train nothing: counts below their minimum, a learning rate that is not a number
+    or schedule, a total that is not a positive whole number.
+
+    Raises:
+        ValueError: one line naming the setting and the cause.
+    """
+    minimum = {"n_steps": 2, "n_epochs": 1, "checkpoint_freq": 1, "n_envs": 1, "eval_episode_steps": 1,
+               "eval_episodes": 1, "torch_threads": 1, "batch_size": 2, "n_minibatches": 1, "eval_freq": 0}
+    values = {**{k: hp.get(k) for k in minimum}, "timesteps": total}
+    minimum["timesteps"] = 1
+    for key, low in minimum.items():
+        value = values[key]
+        if value is None and key in ("batch_size", "n_minibatches"):
+            continue
+        if isinstance(value, bool) or not isinstance(value, int) or value < low:
+            raise ValueError(f"{key} must be a whole number >= {low}, got {value!r}")
+    for key in ("learning_rate", "clip_range", "gamma", "gae_lambda", "ent_coef", "vf_coef", "max_grad_norm"):
+        if key == "learning_rate":
+            schedule(hp[key])
+        elif isinstance(hp.get(key), bool) or not isinstance(hp.get(key), (int, float)):
+            raise ValueError(f"{key} must be a number, got {hp.get(key)!r}")
 
 
 def normalized_rewards(vec_env, checkpoint: Path | None, gamma: float):
@@ -380,7 +395,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     import torch
     from stable_baselines3.common.callbacks import CallbackList
 
-    from ..core.maps import load_map
+    from ..core.maps import load_map, source_label
     from .callbacks import LearningCurveCallback, PaperMetricsEvalCallback
     from .cpu_time import CpuTimeCallback, restart_at
     from .curriculum import CurriculumCallback
@@ -407,7 +422,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
 
     run_dir = Path(run_dir) if run_dir is not None else \
         Path(out) / spec_map.name / variant / (run_id or f"{spec.name}_seed{seed}")
-    config = {"map": spec_map.name, "map_source": map_source(spec_map), "map_shape": list(spec_map.shape),
+    config = {"map": spec_map.name, "map_source": source_label(spec_map), "map_shape": list(spec_map.shape),
               "variant": variant, "algo": spec.name, "seed": int(seed), "timesteps": total,
               "env": cfg.to_dict(), "hyperparams": hp, "versions": versions()}
     checkpoint = None
@@ -422,14 +437,9 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     elif run_dir.exists() and any(run_dir.iterdir()):
         raise ValueError(f"run folder {run_dir} exists; pass --resume to continue it or --run-id to start another")
     start_teams = teams[0] if hp.get("curriculum", True) else final_teams
+    check_run_settings(hp, total)
     vec_env = make_vec_env(spec_map, agents=start_teams, variant=variant, seed=seed, strict=spec.masked,
                            episode_env=mixed_episodes(hp, len(start_teams)), **env_kwargs)  # bad env: no run folder
-    (run_dir / "checkpoints").mkdir(parents=True, exist_ok=True)
-    if not resume:
-        (run_dir / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
-    with (run_dir / "command.txt").open("a") as f:
-        f.write((command or " ".join(sys.argv)) + "\n")
-
     rows = vec_env.num_envs
     if hp.get("normalize_reward", False):
         vec_env = normalized_rewards(vec_env, checkpoint, per_phase(hp["gamma"], vec_env.phases_per_step))
@@ -449,6 +459,12 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
             except RuntimeError as exc:
                 raise ValueError(f"--init-from {config['init_from']['path']}: its network does not match "
                                  f"this run's (another map size, variant or policy_kwargs?): {exc}") from exc
+    # every setting has been accepted (the model is built): now the run folder is made
+    (run_dir / "checkpoints").mkdir(parents=True, exist_ok=True)
+    if not resume:
+        (run_dir / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
+    with (run_dir / "command.txt").open("a") as f:
+        f.write((command or " ".join(sys.argv)) + "\n")
 
     max_agents = vec_env.layout.max_agents
     eval_teams = [k for k in range(1, max_agents + 1) if k <= spec_map.n_vertices] * int(hp.get("eval_episodes", 1))
