@@ -21,6 +21,7 @@ import yaml
 from .core import protocol
 from .core.config import ENV_VERSION, EnvConfig, make_config
 from .core.maps import MapSpec, load_map
+from .runs import read_config, zip_is_intact  # noqa: F401  (zoo.read_config is public)
 
 
 class ZooError(ValueError):
@@ -68,7 +69,7 @@ def read_entry(path: Path) -> dict:
     config_file = path / "config.yml"
     if not config_file.is_file():
         raise ZooError(f"{path}: no config.yml; not a zoo entry")
-    config = yaml.safe_load(config_file.read_text()) or {}
+    config = read_config(config_file)
     eval_file = path / "eval.json"
     evaluation = json.loads(eval_file.read_text()) if eval_file.is_file() else None
     return {"path": str(path), "config": config, "eval": evaluation}
@@ -203,10 +204,20 @@ class ZooPolicy:
 
 
 def env_config(config: dict) -> EnvConfig:
-    """The env parameters a model was trained with, from its config.yml ``env`` section."""
-    env_fields = {f.name for f in dataclasses.fields(EnvConfig)}
-    return EnvConfig(**{k: (tuple(v) if isinstance(v, list) else v)
-                        for k, v in (config.get("env") or {}).items() if k in env_fields})
+    """The env parameters a model was trained with, from its config.yml ``env`` section.
+
+    Raises:
+        ZooError: keys this code does not know (a config of another version), or bad values.
+    """
+    env = config.get("env") or {}
+    unknown = sorted(set(env) - {f.name for f in dataclasses.fields(EnvConfig)})
+    if unknown:
+        raise ZooError(f"config.yml env section has settings this code does not know: {unknown}; "
+                       f"a model of another patrolsb3 version?")
+    try:
+        return EnvConfig(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in env.items()})
+    except (TypeError, ValueError) as exc:
+        raise ZooError(f"config.yml env section: {exc}") from None
 
 
 def checked_map(config: dict, spec, where) -> MapSpec:
@@ -250,7 +261,13 @@ def load_checkpoint(path, spec=None) -> ZooPolicy:
     if not (run_dir / "config.yml").is_file():
         raise ZooError(f"{path}: no config.yml in {run_dir}; give a checkpoint inside a run folder of "
                        f"'patrolsb3 train'")
-    config = yaml.safe_load((run_dir / "config.yml").read_text()) or {}
+    config = read_config(run_dir / "config.yml")
+    version = (config.get("versions") or {}).get("env_version")
+    if version != ENV_VERSION:
+        raise ZooError(f"{run_dir / 'config.yml'}: trained for env version {version!r}, this code is "
+                       f"{ENV_VERSION!r}; retrain it or use a matching patrolsb3 release")
+    if not zip_is_intact(path):
+        raise ZooError(f"{path}: the file is empty, cut or corrupt (its zip check fails)")
     if spec is None:   # the training map file if it is still there, else the map by name
         source = config.get("map_source")
         spec = source if source and Path(source).is_file() else config["map"]
@@ -302,6 +319,9 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None, device: str = "cp
     torch.set_num_threads(1)     # small networks: one thread is fastest, and several oversubscribe
     from .sb3.algorithms import get_algorithm, torch_device
     _, policy_class = get_algorithm(config.get("algo", "MaskableRecurrentPPO")).classes()
+    if not zip_is_intact(folder / "model.zip"):
+        raise ZooError(f"{folder / 'model.zip'}: the file is empty, cut or corrupt (its zip check fails); "
+                       f"restore it from git")
     try:
         policy = policy_class.load(str(folder / "model.zip"), device=torch_device(device))
     except Exception as exc:  # a corrupt or foreign file: say which one
@@ -345,7 +365,7 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None) -
                                                    else newest_checkpoint(run_dir))
     if source is None or not source.is_file():
         raise ZooError(f"{run_dir}: no model.zip and no checkpoint to export")
-    config = yaml.safe_load((run_dir / "config.yml").read_text())
+    config = read_config(run_dir / "config.yml")
     from .sb3.algorithms import get_algorithm
     algo_class, _ = get_algorithm(config["algo"]).classes()
     model = algo_class.load(str(source), device="cpu")

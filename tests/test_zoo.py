@@ -237,3 +237,34 @@ def test_a_model_trained_behind_the_return_guard_acts_behind_it(trained, tmp_pat
     assert cli.main(["zoo", "list", "--zoo-dir", str(tmp_path / "zoo")]) == 0
     listed = capsys.readouterr().out
     assert "room/rl-msg" in listed and "behind the return guard" in listed
+
+
+def test_corrupt_files_and_configs_are_refused_in_one_line(trained, tmp_path):
+    import shutil
+
+    from patrolsb3.core import MapError, load_map
+    copy = tmp_path / "zoo"
+    shutil.copytree(trained["root"] / "zoo", copy)
+    (entry,) = [p.parent for p in copy.glob("*/*/model.zip")]
+    model = entry / "model.zip"
+    data = bytearray(model.read_bytes())
+    data[len(data) // 2] ^= 0xFF                      # flipped bytes: the CRC check fails
+    model.write_bytes(bytes(data))
+    with pytest.raises(zoo.ZooError, match="empty, cut or corrupt"):
+        zoo.load("ROOM", "rl-msg", zoo_dir=copy, spec=trained["map_file"])
+    (entry / "config.yml").write_text("map: [unclosed\n")
+    with pytest.raises(ValueError, match="not valid YAML"):
+        zoo.list_entries(copy)
+    with pytest.raises(zoo.ZooError, match="does not know: \\['warp_drive'\\]"):
+        zoo.env_config({"env": {"warp_drive": True}})
+    # an edited env version in a run's config.yml is refused by load_checkpoint
+    run = tmp_path / "run"
+    shutil.copytree(trained["run"], run)
+    text = (run / "config.yml").read_text()
+    (run / "config.yml").write_text(text.replace("env_version: patrol_v1", "env_version: patrol_v0"))
+    with pytest.raises(zoo.ZooError, match="env version 'patrol_v0'"):
+        zoo.load_checkpoint(run / "model.zip", spec=trained["map_file"])
+    binary = tmp_path / "map.txt"
+    binary.write_bytes(b"S..\n.\xff.\n")
+    with pytest.raises(MapError, match=r"map.txt:2:2: not a text map"):
+        load_map(binary)

@@ -321,9 +321,21 @@ def load_map(name_or_path) -> MapSpec:
             raise MapError(f"{text_name}: map file not found")
         shipped = path.resolve().parent == MAPS_DIR and path.stem.startswith("map_")
         name = path.stem[4:].upper() if shipped else path.stem
-        return parse_map(path.read_text(), name=name, source=str(path))
+        return parse_map(_read_text(path), name=name, source=str(path))
     candidate = MAPS_DIR / f"map_{text_name.lower()}.txt"
     if not candidate.is_file():
         raise MapError(f"unknown map {text_name!r}; known maps: {', '.join(available_maps())} "
                        f"(or give a path to a .txt map file)")
-    return parse_map(candidate.read_text(), name=text_name.upper(), source=str(candidate))
+    return parse_map(_read_text(candidate), name=text_name.upper(), source=str(candidate))
+
+
+def _read_text(path: Path) -> str:
+    """A map file's text; a binary or non-UTF-8 file is a MapError naming the file, line and column."""
+    data = path.read_bytes()
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        column = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise MapError(f"{path}:{line}:{column}: not a text map (byte 0x{data[exc.start]:02x} is not "
+                       f"UTF-8)") from None

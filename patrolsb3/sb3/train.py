@@ -29,6 +29,7 @@ import yaml
 from stable_baselines3.common.callbacks import CheckpointCallback
 from stable_baselines3.common.vec_env import VecNormalize
 
+from ..runs import is_valid_model_file, read_config  # noqa: F401  (re-exported)
 from .algorithms import DEFAULT_ALGORITHM, get_algorithm, torch_device
 from .cpu_time import cpu_hours_of
 from .curriculum import CURRICULUM, curriculum_stage
@@ -70,19 +71,6 @@ def model_steps(model_path) -> int | None:
             return int(json.loads(archive.read("data"))["num_timesteps"])
     except (OSError, KeyError, ValueError, zipfile.BadZipFile):
         return None
-
-
-def is_valid_model_file(path) -> bool:
-    """True for a readable SB3 zip: not empty, every member's CRC right, a ``data`` record (a
-    run killed while writing leaves an empty or cut file; flipped bytes fail the CRC)."""
-    path = Path(path)
-    try:
-        if path.stat().st_size == 0:
-            return False
-        with zipfile.ZipFile(path) as archive:
-            return archive.testzip() is None and "data" in archive.namelist()
-    except (OSError, zipfile.BadZipFile, EOFError):
-        return False
 
 
 def newest_checkpoint(run_dir: Path, skipped: list | None = None) -> Path | None:
@@ -258,7 +246,7 @@ def _check_resumable(run_dir: Path, config: dict) -> Path:
                                 f"(looked for model_<steps>_steps.zip)")
     saved_file = run_dir / "config.yml"
     if saved_file.is_file():
-        saved = yaml.safe_load(saved_file.read_text()) or {}
+        saved = read_config(saved_file)
         for key in ("map", "map_shape", "variant", "algo"):
             if saved.get(key) != config[key]:
                 raise ValueError(f"--resume: {run_dir} was trained with {key}={saved.get(key)!r}, "

@@ -1,0 +1,54 @@
+"""Run-folder files read the same way everywhere (config.yml, model zips).
+
+A first piece of the run folder's one owner: ``sb3/train.py`` (resume), ``zoo.py`` (entries,
+checkpoints) and ``checkpoints.py`` read config files and check model files through here.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import yaml
+
+
+class ConfigError(ValueError):
+    """A config.yml that cannot be read (not YAML, not a mapping)."""
+
+
+def read_config(path: Path) -> dict:
+    """A config.yml as a dict.
+
+    Raises:
+        ConfigError: not valid YAML, or not a mapping (names the file and the problem).
+    """
+    try:
+        config = yaml.safe_load(Path(path).read_text())
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"{path}: not valid YAML ({str(exc).splitlines()[0]})") from None
+    if config is None:
+        return {}
+    if not isinstance(config, dict):
+        raise ConfigError(f"{path}: expected a mapping of settings, got {type(config).__name__}")
+    return config
+
+
+def zip_is_intact(path) -> bool:
+    """True for a non-empty zip whose every member passes its CRC check (a model file)."""
+    import zipfile
+    path = Path(path)
+    try:
+        if path.stat().st_size == 0:
+            return False
+        with zipfile.ZipFile(path) as archive:
+            return archive.testzip() is None
+    except (OSError, zipfile.BadZipFile, EOFError):
+        return False
+
+
+def is_valid_model_file(path) -> bool:
+    """True for a readable SB3 algorithm zip: intact (:func:`zip_is_intact`) with a ``data``
+    record (a run killed while writing leaves an empty or cut file; flipped bytes fail the CRC)."""
+    import zipfile
+    if not zip_is_intact(path):
+        return False
+    with zipfile.ZipFile(path) as archive:
+        return "data" in archive.namelist()
