@@ -61,7 +61,7 @@ def test_load_checkpoint_errors_name_the_file(run, tmp_path):
     bad = run / "checkpoints" / "model_1_steps.zip"
     bad.write_bytes(b"not a zip")
     try:
-        with pytest.raises(zoo.ZooError, match="cannot be loaded"):
+        with pytest.raises(zoo.ZooError, match="empty, cut or corrupt"):
             zoo.load_checkpoint(bad)
     finally:
         bad.unlink()

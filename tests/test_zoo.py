@@ -161,7 +161,7 @@ def test_refusals_name_the_problem(trained, tmp_path):
     config["env_version"] = "patrol_v1"
     (other / "config.yml").write_text(yaml.safe_dump(config))
     (other / "model.zip").write_bytes(b"not a zip")
-    with pytest.raises(zoo.ZooError, match="cannot be loaded"):
+    with pytest.raises(zoo.ZooError, match="empty, cut or corrupt"):
         zoo.load("ROOM", "rl-msg", zoo_dir=tmp_path / "zoo", spec=trained["map_file"])
 
 
