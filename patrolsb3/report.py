@@ -34,10 +34,31 @@ def column_strategy(column: str) -> str:
 
 
 def mean_std(stat: dict, digits: int = 1) -> str:
-    """'mean +- std' of a summary entry, '' when missing or nan."""
+    """'mean +- std' of a summary entry (std over tests), the mean alone when there is one test
+    (no spread to show), '' when missing or nan."""
     if not stat or stat.get("mean") is None or math.isnan(stat["mean"]):
         return ""
+    if len(stat.get("tests", [])) <= 1:
+        return f"{stat['mean']:.{digits}f}"
     return f"{stat['mean']:.{digits}f} +- {stat['std']:.{digits}f}"
+
+
+LOWER_IS_BETTER = ("avg_idleness", "max_idleness", "worst_idleness", "collisions", "battery_failures",
+                   "battery_failure_rate")
+"""Metrics whose best value in a table row (the lowest) is marked in bold."""
+
+
+def _best_marked(cells: list[str], stats: list, metric: str) -> list[str]:
+    """Bold the best (lowest) mean of a row for the metrics of LOWER_IS_BETTER (ties all bold;
+    a row where every value is equal is left plain)."""
+    if metric not in LOWER_IS_BETTER:
+        return cells
+    means = [s["mean"] if s and s.get("mean") is not None and not math.isnan(s["mean"]) else None for s in stats]
+    present = [m for m in means if m is not None]
+    if len(present) < 2 or min(present) == max(present):   # nothing to tell apart
+        return cells
+    best = min(present)
+    return [f"**{c}**" if m is not None and m == best else c for c, m in zip(cells, means)]
 
 
 def evaluation_text(result: dict) -> str:
@@ -91,7 +112,8 @@ def clean_figures(summary: dict, precision: int = 1) -> str:
             f"col {summary['collisions']['mean']:.{precision + 1}f}")
 
 
-def write_compare(results: list[dict], out_dir, plots: bool = True, learning_curves=None) -> list[Path]:
+def write_compare(results: list[dict], out_dir, plots: bool = True, learning_curves=None,
+                  zoo_notes: dict | None = None) -> list[Path]:
     """Write every table, the report and the plots of a comparison.
 
     Args:
@@ -100,6 +122,8 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
         plots: also draw the PNG plots.
         learning_curves: map -> {variant: curve.csv path}; draws the paper's training figure
             (``<MAP>-training.png``) for maps that have any.
+        zoo_notes: (map, strategy) -> a line about a zoo column (its setting and whether its
+            figures were computed now or reused), printed in the report.
 
     Returns:
         The paths written.
@@ -111,14 +135,20 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
     md = ["# Strategy comparison", ""]
     if results:
         r0 = results[0]
+        spread = "mean +- std over tests" if r0["tests"] > 1 else "one test, so the mean alone (no spread to show)"
         md += [f"{r0['tests']} test(s) x {r0['episodes']} episodes x {r0['steps']} steps per "
-               f"(map, strategy, team size); mean +- std over tests. Idleness and collision figures "
-               f"average over episodes without a battery failure (counts in results.csv).", ""]
+               f"(map, strategy, team size); {spread}. Idleness and collision figures "
+               f"average over episodes without a battery failure (counts in results.csv). The best "
+               f"(lowest) value of each row is in bold.", ""]
         learned = [r for r in results if str(r.get("strategy", "")).startswith("zoo:")]
         if learned:
             sampled = any(r.get("deterministic", True) is False for r in learned)
             md += [f"Zoo models {'sample their actions from the policy' if sampled else 'take their most likely legal action'}"
                    f" ({'--stochastic' if sampled else 'deterministic, the default'}).", ""]
+            for (m, strategy), note in sorted((zoo_notes or {}).items()):
+                md.append(f"- map {m}, {strategy}: {note}")
+            if zoo_notes:
+                md.append("")
     for m in maps:
         for suffix, metric in PAPER_TABLES.items():
             md += [f"## Map {m}: {suffix} ({LABELS[metric]})", ""]
@@ -138,7 +168,8 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
             md.append("| n | " + " | ".join(PAPER_COLUMNS + EXTRA_COLUMNS) + " |")
             md.append("|---" * (1 + len(PAPER_COLUMNS + EXTRA_COLUMNS)) + "|")
             for row in rows_all:
-                md.append(f"| {row[0]} | " + " | ".join(mean_std(s, digits) for s in row[1:]) + " |")
+                cells = _best_marked([mean_std(s, digits) for s in row[1:]], row[1:], metric)
+                md.append(f"| {row[0]} | " + " | ".join(cells) + " |")
             md.append("")
         if plots:
             png = plot_map(results, m, out / f"{m}.png")
@@ -172,7 +203,9 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
 
 def plot_map(results: list[dict], map_name: str, path) -> Path:
     """One PNG per map: MAX^h, AVG^h, collisions, battery failure rate and battery % at swap
-    start against team size, one line (with std error bars) per strategy."""
+    start against team size, one line per strategy (std error bars over tests when there are
+    several). Idleness and collisions on a log scale, so that RANDOM (thousands) does not flatten
+    the others; the zoo models dashed with square markers, the heuristics solid."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -183,12 +216,17 @@ def plot_map(results: list[dict], map_name: str, path) -> Path:
     for strategy in sorted({r["strategy"] for r in rows}):
         mine = sorted((r for r in rows if r["strategy"] == strategy), key=lambda r: r["n_agents"])
         ns = [r["n_agents"] for r in mine]
+        learned = strategy.startswith("zoo:")
+        style = dict(marker="s" if learned else "o", linestyle="--" if learned else "-",
+                     linewidth=2.0 if learned else 1.2, capsize=3, label=strategy)
         for ax, metric in zip(axes, panels):
+            several = len(mine[0]["summary"][metric].get("tests", [])) > 1 if mine else False
             ax.errorbar(ns, [r["summary"][metric]["mean"] for r in mine],
-                        yerr=[r["summary"][metric]["std"] for r in mine], marker="o", capsize=3,
-                        label=strategy)
+                        yerr=[r["summary"][metric]["std"] for r in mine] if several else None, **style)
     for ax, metric in zip(axes, panels):
-        ax.set_title(LABELS[metric])
+        if metric in ("max_idleness", "avg_idleness", "collisions"):
+            ax.set_yscale("symlog" if metric == "collisions" else "log")
+        ax.set_title(LABELS[metric] + (" (log)" if metric in ("max_idleness", "avg_idleness", "collisions") else ""))
         ax.set_xlabel("agents")
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8)

@@ -19,7 +19,8 @@ def fake(map_name, n, strategy, max_mean, max_std=0.5):
 
 
 def test_mean_std_format():
-    assert mean_std({"mean": 1.25, "std": 0.5}, 2) == "1.25 +- 0.50"
+    assert mean_std({"mean": 1.25, "std": 0.5, "tests": [0.75, 1.75]}, 2) == "1.25 +- 0.50"
+    assert mean_std({"mean": 1.25, "std": 0.0, "tests": [1.25]}, 2) == "1.25"     # one test: no "+- 0.00"
     assert mean_std({"mean": float("nan"), "std": 0.0}) == ""
 
 
@@ -35,7 +36,8 @@ def test_write_compare_tables(tmp_path):
         ["n", "RANDOM", "CYCLIC"], ["1", "", "9"], ["2", "", ""]]
     assert list(csv.reader((tmp_path / "B-BLv.csv").open()))[1] == ["1", "", "", "", "", "", ""]
     report = (tmp_path / "report.md").read_text()
-    assert "| 1 | 12.5 +- 0.5 |  |  |  |  | 3.0 +- 0.5 |  | 9.0 +- 0.5 |" in report
+    assert "| 1 | 12.5 |  |  |  |  | **3.0** |  | 9.0 |" in report       # one test; the best in bold
+    assert "one test, so the mean alone" in report
     long_rows = list(csv.DictReader((tmp_path / "results.csv").open()))
     assert len(long_rows) == 5 * 8
 
@@ -46,7 +48,7 @@ def test_evaluation_text_lists_every_metric():
                   "battery failures / episode", "battery failure rate", "battery % at swap start",
                   "|V|/k", "4 of 4"):
         assert label in text
-    assert "| MAX^h (episodes without battery failure) | 42.00 +- 0.50 |" in text
+    assert "| MAX^h (episodes without battery failure) | 42.00 |" in text
 
 
 def test_report_draws_the_training_figure_of_zoo_curves(tmp_path):

@@ -22,6 +22,16 @@ def parse_agents(text: str) -> list[int]:
     return sorted(sizes)
 
 
+def zoo_note(zoo, map_name: str, strategy: str, reused: bool) -> str:
+    """The report's line about a zoo column: its setting (behind the return guard or the paper's)
+    and whether its figures were reused from the entry's eval.json or computed now."""
+    config = zoo.read_entry(zoo.entry_dir(map_name, strategy.split(":", 1)[1]))["config"]
+    guarded = bool((config.get("env") or {}).get("return_guard"))
+    setting = ("behind the return guard (env.return_guard, ours: the heuristics' recharge rule as a "
+               "shield)" if guarded else "the paper's setting (no return guard)")
+    return f"{setting}; figures {'reused from its eval.json' if reused else 'computed now'}"
+
+
 def add_arguments(parser):
     parser.add_argument("--maps", default="A,B,C,D", help="comma-separated maps (default A,B,C,D)")
     parser.add_argument("--agents", default="1-5", help="team sizes, e.g. 1-5 or 1,3,5 (default 1-5)")
@@ -83,6 +93,7 @@ def run(args):
                 raise ValueError(f"{name}: no zoo model for map(s) {', '.join(missing)}")
     store = ResultStore(args.out)
     results = []
+    zoo_notes = {}
     for m in maps:
         if args.strategies:
             names = [canonical_name(s) for s in args.strategies.split(",") if s.strip()]
@@ -113,11 +124,13 @@ def run(args):
                       f"BF {s['battery_failure_rate']['mean']:.3f} BLv {s['swap_battery_pct']['mean']:.1f}{source}",
                       flush=True)
                 results.append(r)
+                if name.startswith("zoo:"):
+                    zoo_notes[(m.upper(), name)] = zoo_note(zoo, m, name, reused=bool(source))
     curves = {}
     if zoo is not None:
         for m in maps:
             curves[m.upper()] = {v: p for v in zoo.VARIANT_NAMES
                                  if (p := zoo.entry_dir(m, v) / "curve.csv").is_file()}
-    paths = write_compare(results, args.out, learning_curves=curves)
+    paths = write_compare(results, args.out, learning_curves=curves, zoo_notes=zoo_notes)
     print(f"wrote {len(paths)} files to {args.out} (report: {args.out}/report.md)")
     return 0
