@@ -36,6 +36,9 @@ def add_arguments(parser):
     p_val.add_argument("--steps", type=int, default=3000, help="steps per episode (default 3000 = 5 h)")
     p_val.add_argument("--seed", type=int, default=7, help="simulator seed (default 7; the zoo's eval uses 0)")
     p_val.add_argument("--last", type=int, default=None, help="only the newest N checkpoints")
+    p_cards = sub.add_parser("cards", help="write one model card (markdown) per entry and an index")
+    p_cards.add_argument("--out", default="docs/zoo", help="folder of the cards (default docs/zoo)")
+    p_cards.add_argument("--zoo-dir", default=None)
     p_lis = sub.add_parser("listening", help="how much an entry's moves depend on the symbols it receives "
                                              "(KL and greedy change when they are randomised) and how it "
                                              "uses its alphabet")
@@ -68,6 +71,13 @@ def run(args):
         return export_and_evaluate(args)
     if args.zoo_command == "validate":
         return validate_checkpoints(args)
+    if args.zoo_command == "cards":
+        from ..outputs import check_output_dir
+        from ..zoo_cards import write_cards
+        check_output_dir(args.out, "--out")
+        paths = write_cards(args.out, zoo_dir=args.zoo_dir)
+        print(f"wrote {len(paths)} files to {args.out}")
+        return 0
     if args.zoo_command == "listening":
         from ..listening import listening
         from ..zoo import load

@@ -16,6 +16,8 @@ difference reward weighted 200, and legible messages (``message_encoding=planes`
 from __future__ import annotations
 
 import copy
+from pathlib import Path
+from typing import Any
 
 SHARED = {"normalize_reward": True, "gamma": 0.99, "batch_size": 2048,
           "env": {"local_idleness": True, "c_d": 200.0, "message_encoding": "planes"}}
@@ -48,7 +50,7 @@ STAGE1_SHARE = 0.2
 
 def train_in_stages(map="A", variant: str = "rl-msg", timesteps: int = 10_000_000, seed: int = 0,
                     out="runs/", run_id: str | None = None, resume: bool = False,
-                    overrides: dict | None = None, **train_kwargs):
+                    overrides: dict | None = None, **train_kwargs: Any) -> Path:
     """The zoo's recipe in one call: ``zoo-stage1`` for a fifth of ``timesteps``, then
     ``zoo-stage2`` from its weights for the rest.
 
@@ -59,13 +61,11 @@ def train_in_stages(map="A", variant: str = "rl-msg", timesteps: int = 10_000_00
     Args:
         timesteps: agent-steps of both stages together.
         overrides: hyperparameters applied on top of each stage's recipe (``--set``).
-        **train_kwargs: passed to :func:`patrolsb3.sb3.train.train` (progress_bar, device ...).
+        **train_kwargs (Any): passed to :func:`patrolsb3.sb3.train.train` (progress_bar, device ...).
 
     Returns:
-        The stage-2 run folder.
+        Path: the stage-2 run folder.
     """
-    from pathlib import Path
-
     from .hyperparams import merge
     from .train import model_steps, train
     run_id = run_id or f"seed{seed}"

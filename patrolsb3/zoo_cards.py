@@ -1,0 +1,76 @@
+"""Model cards of the zoo's entries (``patrolsb3 zoo cards --out docs/zoo``): one markdown page
+per entry, in the spirit of the Hugging Face SB3 model cards (library, env, settings, budget,
+evaluation, usage), and an index of them."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from .report import ZOO_TABLE_METRICS
+
+VARIANT_TEXT = {"rl-msg": "learned 16-symbol messages (RIAL)", "rl-no-msg": "positions only, no messages",
+                "rl-intention": "each agent announces its intended move (a fixed meaning)"}
+PAPER_BUDGET = ("the paper's budget, as we read it: 1,500 episodes of 5,000 simulator steps, 8 in "
+                "parallel, i.e. 7.5 M simulator steps of episodes (~15-18 M agent decisions with messages)")
+
+
+def card(entry: dict) -> str:
+    """The markdown card of one entry (``patrolsb3.zoo.read_entry``'s dict)."""
+    c, ev = entry["config"], entry.get("eval") or {}
+    env, budget = c.get("env") or {}, c.get("budget") or {}
+    name = f"{c.get('map')}/{c.get('variant')}"
+    guarded = bool(env.get("return_guard"))
+    lines = [f"# {name}", "",
+             f"- **variant**: `{c.get('variant')}`, {VARIANT_TEXT.get(c.get('variant'), '')}",
+             f"- **algorithm**: {c.get('algo')} (patrolsb3, Stable-Baselines3 / sb3-contrib), env "
+             f"`{c.get('env_version')}`, trained {c.get('date', '?')}",
+             f"- **setting**: " + ("**behind the return guard** (`env.return_guard`, ours: the heuristics' "
+                                   "recharge rule as a shield on the moves; not the paper's setting)"
+                                   if guarded else "the paper's setting (no return guard)"),
+             f"- **observation**: messages `{env.get('message_encoding', 'scalar')}`, local idleness "
+             f"{'on' if env.get('local_idleness') else 'off'}, difference-reward weight c_d = {env.get('c_d')}",
+             f"- **budget**: {int(budget.get('timesteps', 0)):,} agent-steps (all stages), "
+             f"{budget.get('cpu_hours', '?')} CPU hours; {PAPER_BUDGET}",
+             f"- **seeds**: one (training seed {c.get('seed')}); no spread over seeds yet", ""]
+    if ev:
+        lines += [f"## Evaluation", "",
+                  f"{ev.get('tests')} test x {ev.get('episodes')} episodes x {ev.get('steps')} steps per "
+                  f"team size, seed {ev.get('seed')}, "
+                  f"{'most likely legal action' if ev.get('deterministic', True) else 'sampled actions'}; "
+                  f"one test gives no interval (per-episode intervals: not stored yet).", "",
+                  "| n | " + " | ".join(h for _, h, _ in ZOO_TABLE_METRICS) + " |",
+                  "|---" * (1 + len(ZOO_TABLE_METRICS)) + "|"]
+        for row in ev.get("results", []):
+            s = row["summary"]
+            cells = []
+            for key, _, digits in ZOO_TABLE_METRICS:
+                mean = (s.get(key) or {}).get("mean")
+                cells.append("" if mean is None or mean != mean else f"{mean:.{digits}f}")
+            lines.append(f"| {row['n_agents']} | " + " | ".join(cells) + " |")
+        lines.append("")
+    lines += ["## How to load it", "", "```python", "import patrolsb3",
+              "from patrolsb3 import zoo", "from patrolsb3.agents import PettingZooAgent, play_episode", "",
+              f"policy = zoo.load({c.get('map')!r}, {c.get('variant')!r})        # evaluation: --strategy zoo:{c.get('variant')}",
+              f"env = patrolsb3.parallel_env({c.get('map')!r}, n_agents=3, **policy.env_settings())",
+              "print(play_episode(env, PettingZooAgent(policy, env), seed=0))", "```", ""]
+    return "\n".join(lines)
+
+
+def write_cards(out_dir, zoo_dir=None) -> list[Path]:
+    """Write one card per zoo entry and ``index.md`` into ``out_dir``; returns the paths."""
+    from .zoo import list_entries
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written, index = [], ["# Model cards", "", "| entry | variant | setting | agent-steps | CPU h |",
+                          "|---|---|---|---|---|"]
+    for entry in list_entries(zoo_dir):
+        c = entry["config"]
+        stem = f"{c.get('map')}-{c.get('variant')}"
+        path = out / f"{stem}.md"
+        path.write_text(card(entry))
+        written.append(path)
+        guarded = "return guard" if (c.get("env") or {}).get("return_guard") else "paper's"
+        budget = c.get("budget") or {}
+        index.append(f"| [{c.get('map')}/{c.get('variant')}]({stem}.md) | {c.get('variant')} | {guarded} | "
+                     f"{int(budget.get('timesteps', 0)):,} | {budget.get('cpu_hours', '?')} |")
+    (out / "index.md").write_text("\n".join(index) + "\n")
+    return written + [out / "index.md"]
