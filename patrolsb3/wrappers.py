@@ -52,3 +52,27 @@ class FlatObservations(BaseParallelWrapper):
     def step(self, actions):
         observations, rewards, terminations, truncations, infos = self.env.step(actions)
         return self._flat(observations), rewards, terminations, truncations, infos
+
+
+class FlatMasks(BaseParallelWrapper):
+    """Each agent's ``info["action_mask"]`` as one flat (n_symbols + 5,) bool array (message
+    mask, then move mask) instead of PettingZoo's tuple for ``MultiDiscrete``: what TorchRL's
+    ``PettingZooWrapper(env, use_mask=True)`` reads. ::
+
+        from torchrl.envs import PettingZooWrapper
+        env = PettingZooWrapper(env=FlatMasks(patrolsb3.parallel_env("A", n_agents=3, max_agents=3)),
+                                use_mask=True, categorical_actions=True)
+    """
+
+    @staticmethod
+    def _flat(infos: dict) -> dict:
+        return {a: {**{k: v for k, v in info.items() if k != "action_mask_flat"},
+                    "action_mask": np.asarray(info["action_mask_flat"], dtype=bool)} for a, info in infos.items()}
+
+    def reset(self, seed=None, options=None):
+        observations, infos = self.env.reset(seed=seed, options=options)
+        return observations, self._flat(infos)
+
+    def step(self, actions):
+        observations, rewards, terminations, truncations, infos = self.env.step(actions)
+        return observations, rewards, terminations, truncations, self._flat(infos)

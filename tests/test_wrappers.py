@@ -51,3 +51,19 @@ def test_stock_supersuit_and_maskable_ppo_with_the_mask_wrapper():
 def test_pettingzoo_render_and_performance_tests():
     render_test(functools.partial(patrolsb3.env, "A", n_agents=2, invalid_action="stay", episode_steps=15))
     performance_benchmark(patrolsb3.env("A", n_agents=2, invalid_action="stay", episode_steps=50))
+
+
+def test_torchrl_pettingzoo_wrapper_checks_specs_and_rolls_out_masked():
+    """TorchRL builds on the env (flat masks in the info): its spec check passes and a random
+    rollout under the masks runs on a strict env (a masked action would raise)."""
+    import pytest
+    torchrl = pytest.importorskip("torchrl", reason="torchrl is not installed (pip install -e '.[test]')")
+    from torchrl.envs import PettingZooWrapper
+    from torchrl.envs.utils import check_env_specs
+
+    from patrolsb3.wrappers import FlatMasks
+    base = FlatMasks(patrolsb3.parallel_env("A", n_agents=3, max_agents=3, seed=0, episode_steps=30))
+    env = PettingZooWrapper(env=base, use_mask=True, categorical_actions=True)
+    check_env_specs(env)
+    rollout = env.rollout(40)
+    assert rollout.batch_size[0] == 40 and torchrl.__version__
