@@ -158,3 +158,27 @@ def test_n_minibatches_splits_the_deployed_rows():
     assert model.update_batch_size() == -(-model.n_steps * 4 // 3)
     sizes = [int((d.mask > 0.5).sum()) for d in model.rollout_buffer.get(model.update_batch_size())]
     assert sum(sizes) == model.n_steps * 4 and len(sizes) == 3
+
+
+def test_a_zoo_model_zip_loads_as_an_sb3_model_and_acts_on_the_training_env():
+    """SB3 users' way: MaskableRecurrentPPO.load(zoo model.zip) (a policy only), predict with
+    action_masks on the training vec env's rows; with env= it trains on."""
+    from pathlib import Path
+
+    from patrolsb3 import zoo
+    entry = Path(__file__).resolve().parent.parent / "zoo" / "A" / "rl-msg" / "model.zip"
+    model = MaskableRecurrentPPO.load(entry, device="cpu")
+    policy = zoo.load("A", "rl-msg")
+    settings = {k: v for k, v in policy.env_settings().items() if k != "comm"}
+    venv = make_vec_env("A", agents=[3, 2], variant="rl-msg", seed=0, **settings)
+    obs, masks = venv.reset(), venv.action_masks()
+    starts = np.ones(venv.num_envs, dtype=bool)
+    actions, state = model.predict(obs, state=None, episode_start=starts, deterministic=True, action_masks=masks)
+    reference, _ = policy.policy.predict(obs, state=None, episode_start=starts, deterministic=True,
+                                         action_masks=masks)
+    np.testing.assert_array_equal(actions, reference)
+    assert masks[np.arange(len(actions)), actions[:, 0]].all()
+    venv.step(actions)                                       # a strict env accepts them
+    trainable = MaskableRecurrentPPO.load(entry, env=venv, device="cpu", n_steps=8, batch_size=32)
+    trainable.learn(8 * venv.num_envs)
+    assert trainable.num_timesteps == 8 * venv.num_envs

@@ -285,6 +285,39 @@ class MaskableRecurrentPPO(RecurrentPPO):
         """
         return self.policy.predict(observation, state, episode_start, deterministic, action_masks=action_masks)
 
+    @classmethod
+    def load(cls, path, env=None, device="auto", custom_objects=None, print_system_info: bool = False,
+             force_reset: bool = True, **kwargs):
+        """SB3's ``load`` of a saved algorithm, and also of a zoo ``model.zip`` (a policy only, no
+        optimizer): then the algorithm is built around the policy (on ``env`` if given, else on
+        a stand-in env of the policy's spaces), so that ``predict(obs, state, episode_start,
+        action_masks=...)`` works as for any SB3 model; to train further, pass ``env``.
+
+        Args:
+            path: an algorithm zip (``model.save``) or a policy zip (``policy.save``, the zoo's).
+            env: the vec env to attach (e.g. ``patrolsb3.sb3.make_vec_env``), or None.
+            device, custom_objects, print_system_info, force_reset, **kwargs: as SB3's ``load``.
+        """
+        import zipfile
+        with zipfile.ZipFile(path) as archive:
+            policy_only = "data" not in archive.namelist()
+        if not policy_only:
+            return super().load(path, env=env, device=device, custom_objects=custom_objects,
+                                print_system_info=print_system_info, force_reset=force_reset, **kwargs)
+        import gymnasium as gym
+        from stable_baselines3.common.vec_env import DummyVecEnv
+        policy = PatrolRecurrentPolicy.load(str(path), device=device)
+        params = policy._get_constructor_parameters()
+        spaces = {"observation_space": params.pop("observation_space"), "action_space": params.pop("action_space")}
+        for key in ("lr_schedule", "use_sde", "squash_output", "full_std", "use_expln"):   # the algorithm's
+            params.pop(key, None)
+        if env is None:
+            stand_in = type("PolicySpaces", (gym.Env,), {**spaces, "reset": None, "step": None})
+            env = DummyVecEnv([stand_in])
+        model = cls(PatrolRecurrentPolicy, env, policy_kwargs=params, device=device, **kwargs)
+        model.policy.load_state_dict(policy.state_dict())
+        return model
+
     def learn(self, total_timesteps: int, callback=None, log_interval: int = 1,
               tb_log_name: str = "MaskableRecurrentPPO", reset_num_timesteps: bool = True, progress_bar: bool = False):
         return super().learn(total_timesteps=total_timesteps, callback=callback, log_interval=log_interval,
