@@ -122,6 +122,22 @@ def run_episodes(policy, spec, cfg, n_agents: int, n_envs: int, seed: int = 0, p
     return result
 
 
+def interval95(values, resamples: int = 2000) -> list:
+    """95 % interval of the mean of ``values`` (per-episode figures): scipy's percentile bootstrap
+    (seeded, so a table is reproducible); [mean, mean] for fewer than 2 finite values or no
+    spread, [nan, nan] for none."""
+    values = np.asarray(values, dtype=np.float64)
+    values = values[np.isfinite(values)]
+    if len(values) == 0:
+        return [float("nan"), float("nan")]
+    if len(values) < 2 or values.min() == values.max():
+        return [float(values.mean()), float(values.mean())]
+    from scipy.stats import bootstrap
+    ci = bootstrap((values,), np.mean, confidence_level=0.95, n_resamples=resamples, method="percentile",
+                   random_state=0).confidence_interval
+    return [float(ci.low), float(ci.high)]
+
+
 def summarize(per_episode: dict, tests: int) -> dict:
     """Per-test figures and their mean / std over tests.
 
@@ -130,20 +146,25 @@ def summarize(per_episode: dict, tests: int) -> dict:
         tests: number of tests.
 
     Returns:
-        dict metric -> {"mean", "std", "tests": [per-test values]}, plus ``clean_episodes``
-        (per-test counts of episodes without a battery failure) and ``segments``.
+        dict metric -> {"mean", "std", "tests": [per-test values], "ci95": [low, high]}: std over
+        tests, and a 95 % bootstrap interval of the mean over the episodes themselves
+        (:func:`interval95`; the episodes a metric counts), plus ``clean_episodes`` (per-test
+        counts of episodes without a battery failure) and ``segments``.
     """
     failed = per_episode["failed"].reshape(tests, -1)                        # (T, N)
     clean = ~failed
     out = {}
 
-    def stats(values):
+    def stats(values, episodes=None):
         values = np.asarray(values, dtype=np.float64)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            return {"mean": float(np.nanmean(values)) if np.isfinite(values).any() else float("nan"),
-                    "std": float(np.nanstd(values)) if np.isfinite(values).any() else float("nan"),
-                    "tests": [float(v) for v in values]}
+            result = {"mean": float(np.nanmean(values)) if np.isfinite(values).any() else float("nan"),
+                      "std": float(np.nanstd(values)) if np.isfinite(values).any() else float("nan"),
+                      "tests": [float(v) for v in values]}
+        if episodes is not None:
+            result["ci95"] = interval95(episodes)
+        return result
 
     def clean_mean(x):
         x = x.reshape(tests, -1)
@@ -151,16 +172,19 @@ def summarize(per_episode: dict, tests: int) -> dict:
         return np.where(n > 0, np.where(clean, x, 0.0).sum(axis=1) / np.maximum(n, 1), np.nan)
 
     for name in CLEAN_METRICS:
-        out[name] = stats(clean_mean(per_episode[name]))
+        values = np.asarray(per_episode[name], dtype=np.float64)
+        out[name] = stats(clean_mean(values), values[clean.reshape(-1)])
         # the same over every episode, failed ones included (not in the paper's tables; it
         # keeps a strategy whose every episode fails from having no idleness figure at all)
-        out[f"{name}_all"] = stats(per_episode[name].reshape(tests, -1).mean(axis=1))
-    out["battery_failures"] = stats(per_episode["battery_failures"].reshape(tests, -1).mean(axis=1))
-    out["battery_failure_rate"] = stats(failed.mean(axis=1))
+        out[f"{name}_all"] = stats(values.reshape(tests, -1).mean(axis=1), values)
+    out["battery_failures"] = stats(per_episode["battery_failures"].reshape(tests, -1).mean(axis=1),
+                                    per_episode["battery_failures"])
+    out["battery_failure_rate"] = stats(failed.mean(axis=1), failed.reshape(-1).astype(np.float64))
     swaps = per_episode["swaps"].reshape(tests, -1)
     level = np.nan_to_num(per_episode["swap_battery"]).reshape(tests, -1) * swaps
     with np.errstate(invalid="ignore", divide="ignore"):
-        out["swap_battery_pct"] = stats(100.0 * level.sum(axis=1) / swaps.sum(axis=1))
+        out["swap_battery_pct"] = stats(100.0 * level.sum(axis=1) / swaps.sum(axis=1),
+                                        100.0 * np.asarray(per_episode["swap_battery"])[swaps.reshape(-1) > 0])
     out["clean_episodes"] = [int(n) for n in clean.sum(axis=1)]
     out["segments"] = [{"start": s["start"], "end": s["end"],
                         "avg_idleness": stats(clean_mean(s["avg"])),

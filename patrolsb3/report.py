@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import csv
 import math
+
+import numpy as np
 from pathlib import Path
 
 PAPER_TABLES = {"BF": "battery_failure_rate", "BLv": "swap_battery_pct", "MAX": "max_idleness",
@@ -38,9 +40,11 @@ def mean_std(stat: dict, digits: int = 1) -> str:
     (no spread to show), '' when missing or nan."""
     if not stat or stat.get("mean") is None or math.isnan(stat["mean"]):
         return ""
+    ci = stat.get("ci95")
+    interval = (f" [{ci[0]:.{digits}f}, {ci[1]:.{digits}f}]" if ci and not math.isnan(ci[0]) else "")
     if len(stat.get("tests", [])) <= 1:
-        return f"{stat['mean']:.{digits}f}"
-    return f"{stat['mean']:.{digits}f} +- {stat['std']:.{digits}f}"
+        return f"{stat['mean']:.{digits}f}{interval}"
+    return f"{stat['mean']:.{digits}f} +- {stat['std']:.{digits}f}{interval}"
 
 
 LOWER_IS_BETTER = ("avg_idleness", "max_idleness", "worst_idleness", "collisions", "battery_failures",
@@ -66,7 +70,8 @@ def evaluation_text(result: dict) -> str:
     s = result["summary"]
     tests, episodes = result["tests"], result["episodes"]
     lines = [f"{result['strategy']} on map {result['map']}, {result['n_agents']} agent(s): "
-             f"{tests} test(s) x {episodes} episodes x {result['steps']} steps (mean +- std over tests)",
+             f"{tests} test(s) x {episodes} episodes x {result['steps']} steps (mean, +- std over tests "
+             f"when several, [95 % bootstrap interval over the episodes])",
              "", "| metric | value |", "|---|---|"]
     for key, label in LABELS.items():
         digits = 3 if key == "battery_failure_rate" else 2
@@ -135,7 +140,9 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
     md = ["# Strategy comparison", ""]
     if results:
         r0 = results[0]
-        spread = "mean +- std over tests" if r0["tests"] > 1 else "one test, so the mean alone (no spread to show)"
+        spread = ("mean +- std over tests" if r0["tests"] > 1 else "one test") + \
+            ", with a 95 % bootstrap interval over the episodes in brackets where the result has one " \
+            "(results computed before 2026-12-02 have none)"
         md += [f"{r0['tests']} test(s) x {r0['episodes']} episodes x {r0['steps']} steps per "
                f"(map, strategy, team size); {spread}. Idleness and collision figures "
                f"average over episodes without a battery failure (counts in results.csv). The best "
@@ -201,6 +208,18 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
     return written
 
 
+def _error_bars(rows: list[dict], metric: str, means: np.ndarray):
+    """(2, n) distances to the 95 % interval over episodes where the results have one, else the
+    std over tests where there are several, else None."""
+    intervals = [r["summary"][metric].get("ci95") for r in rows]
+    if all(ci is not None for ci in intervals):
+        low, high = np.array(intervals, dtype=float).T
+        return np.nan_to_num(np.vstack([means - low, high - means]).clip(min=0))
+    if rows and len(rows[0]["summary"][metric].get("tests", [])) > 1:
+        return [r["summary"][metric]["std"] for r in rows]
+    return None
+
+
 def plot_map(results: list[dict], map_name: str, path) -> Path:
     """One PNG per map: MAX^h, AVG^h, collisions, battery failure rate and battery % at swap
     start against team size, one line per strategy (std error bars over tests when there are
@@ -220,9 +239,8 @@ def plot_map(results: list[dict], map_name: str, path) -> Path:
         style = dict(marker="s" if learned else "o", linestyle="--" if learned else "-",
                      linewidth=2.0 if learned else 1.2, capsize=3, label=strategy)
         for ax, metric in zip(axes, panels):
-            several = len(mine[0]["summary"][metric].get("tests", [])) > 1 if mine else False
-            ax.errorbar(ns, [r["summary"][metric]["mean"] for r in mine],
-                        yerr=[r["summary"][metric]["std"] for r in mine] if several else None, **style)
+            means = np.array([r["summary"][metric]["mean"] for r in mine], dtype=float)
+            ax.errorbar(ns, means, yerr=_error_bars(mine, metric, means), **style)
     for ax, metric in zip(axes, panels):
         if metric in ("max_idleness", "avg_idleness", "collisions"):
             ax.set_yscale("symlog" if metric == "collisions" else "log")

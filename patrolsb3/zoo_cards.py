@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .report import ZOO_TABLE_METRICS
+from .report import ZOO_TABLE_METRICS, mean_std
 
 VARIANT_TEXT = {"rl-msg": "learned 16-symbol messages (RIAL)", "rl-no-msg": "positions only, no messages",
                 "rl-intention": "each agent announces its intended move (a fixed meaning)"}
@@ -36,15 +36,16 @@ def card(entry: dict) -> str:
                   f"{ev.get('tests')} test x {ev.get('episodes')} episodes x {ev.get('steps')} steps per "
                   f"team size, seed {ev.get('seed')}, "
                   f"{'most likely legal action' if ev.get('deterministic', True) else 'sampled actions'}; "
-                  f"one test gives no interval (per-episode intervals: not stored yet).", "",
+                  f"the 95 % bootstrap interval over episodes is in brackets where the evaluation "
+                  f"stored one (evaluations before 2026-12-02 did not: rerun `patrolsb3 zoo export` "
+                  f"or `write_eval` to get them).", "",
                   "| n | " + " | ".join(h for _, h, _ in ZOO_TABLE_METRICS) + " |",
                   "|---" * (1 + len(ZOO_TABLE_METRICS)) + "|"]
         for row in ev.get("results", []):
             s = row["summary"]
             cells = []
             for key, _, digits in ZOO_TABLE_METRICS:
-                mean = (s.get(key) or {}).get("mean")
-                cells.append("" if mean is None or mean != mean else f"{mean:.{digits}f}")
+                cells.append(mean_std(s.get(key) or {}, digits))
             lines.append(f"| {row['n_agents']} | " + " | ".join(cells) + " |")
         lines.append("")
     lines += ["## How to load it", "", "```python", "import patrolsb3",

@@ -18,6 +18,21 @@ def fake(map_name, n, strategy, max_mean, max_std=0.5):
             "steps": 10, "summary": summary, "bounds": {"v_over_k": 10.0, "worst": 9.0, "avg": 4.5}}
 
 
+def test_intervals_over_episodes_are_shown_and_drawn(tmp_path):
+    from patrolsb3.evaluate import interval95
+    low, high = interval95([10.0, 12.0, 14.0, 9.0, 15.0, 11.0])
+    assert 9.0 < low < 11.8 < high < 15.0
+    assert interval95([3.0]) == [3.0, 3.0] and interval95([2.0, 2.0]) == [2.0, 2.0]
+    stat = {"mean": 11.8, "std": 0.0, "tests": [11.8], "ci95": [low, high]}
+    assert mean_std(stat) == f"11.8 [{low:.1f}, {high:.1f}]"
+    results = [fake("B", 1, "CR", 12.5), fake("B", 2, "CR", 7.25)]
+    for r in results:
+        r["summary"]["max_idleness"]["ci95"] = [r["summary"]["max_idleness"]["mean"] - 1, r["summary"]["max_idleness"]["mean"] + 2]
+    write_compare(results, tmp_path, plots=True)
+    assert "| 1 | 12.5 [11.5, 14.5] |" in (tmp_path / "report.md").read_text()
+    assert (tmp_path / "B.png").stat().st_size > 1000
+
+
 def test_mean_std_format():
     assert mean_std({"mean": 1.25, "std": 0.5, "tests": [0.75, 1.75]}, 2) == "1.25 +- 0.50"
     assert mean_std({"mean": 1.25, "std": 0.0, "tests": [1.25]}, 2) == "1.25"     # one test: no "+- 0.00"
@@ -37,7 +52,7 @@ def test_write_compare_tables(tmp_path):
     assert list(csv.reader((tmp_path / "B-BLv.csv").open()))[1] == ["1", "", "", "", "", "", ""]
     report = (tmp_path / "report.md").read_text()
     assert "| 1 | 12.5 |  |  |  |  | **3.0** |  | 9.0 |" in report       # one test; the best in bold
-    assert "one test, so the mean alone" in report
+    assert "one test, with a 95 % bootstrap interval over the episodes" in report
     long_rows = list(csv.DictReader((tmp_path / "results.csv").open()))
     assert len(long_rows) == 5 * 8
 

@@ -320,13 +320,14 @@ def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]
         raise FileNotFoundError(f"--init-from: no model at {path} (give a checkpoint .zip, a zoo "
                                 f"model.zip or a folder holding model.zip)")
     errors = []
-    try:  # a whole model (checkpoint or run's model.zip)
-        model = algo_class.load(str(path), device="cpu")
-        return model.policy.state_dict(), {"path": str(path),
-                                           "timesteps": int(model.num_timesteps) + earlier_stages(path),
-                                           "cpu_hours": cpu_hours_of(path)}
-    except Exception as exc:  # noqa: BLE001 - try the policy-only layout next
-        errors.append(f"as a {algo_class.__name__}: {type(exc).__name__}: {exc}")
+    if is_valid_model_file(path):   # a whole model (checkpoint or run's model.zip), not a policy only
+        try:
+            model = algo_class.load(str(path), device="cpu")
+            return model.policy.state_dict(), {"path": str(path),
+                                               "timesteps": int(model.num_timesteps) + earlier_stages(path),
+                                               "cpu_hours": cpu_hours_of(path)}
+        except Exception as exc:  # noqa: BLE001 - try the policy-only layout next
+            errors.append(f"as a {algo_class.__name__}: {type(exc).__name__}: {exc}")
     try:  # a policy only (the zoo's model.zip)
         policy = policy_class.load(str(path), device="cpu")
     except Exception as exc:  # noqa: BLE001
