@@ -52,3 +52,34 @@ def is_valid_model_file(path) -> bool:
         return False
     with zipfile.ZipFile(path) as archive:
         return "data" in archive.namelist()
+
+
+def trim_rows(path, timesteps: int) -> int:
+    """Cut a run's CSV (curve.csv, eval.csv) back to the rows at or before ``timesteps`` (the
+    checkpoint a resume starts from), dropping a cut last line; rewritten atomically. Returns the
+    rows kept (0 when the file does not exist)."""
+    import csv
+    import os
+    path = Path(path)
+    if not path.is_file():
+        return 0
+    with path.open(newline="") as f:
+        reader = csv.reader(f)
+        header = next(reader, None)
+        if header is None or "timesteps" not in header:
+            return 0
+        column = header.index("timesteps")
+        kept = []
+        for row in reader:
+            try:
+                if len(row) == len(header) and int(row[column]) <= timesteps:
+                    kept.append(row)
+            except ValueError:          # a line cut by a kill
+                continue
+    partial = path.with_name(f".{path.name}.partial")
+    with partial.open("w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(header)
+        writer.writerows(kept)
+    os.replace(partial, path)
+    return len(kept)

@@ -177,3 +177,22 @@ def test_nearest_station_steps_and_first_move():
     assert steps.tolist() == [[0, 1, 2, 2]]
     # ties go to the first action in order: (1,1) Up before Left, (2,1) Down before Right
     assert first.tolist() == [[STAY, LEFT, UP, DOWN]]
+
+
+def test_a_map_over_the_size_limit_is_refused_at_once():
+    import time
+
+    from patrolsb3.core.maps import MAX_FREE_CELLS
+    side = int(MAX_FREE_CELLS ** 0.5) + 2                      # just over the limit
+    text = "\n".join(["S" + "." * (side - 1)] + ["." * side] * (side - 1))
+    start = time.perf_counter()
+    with pytest.raises(MapError, match=f"the limit is {MAX_FREE_CELLS:,}"):
+        parse_map(text, name="huge")
+    assert time.perf_counter() - start < 2.0                  # refused before any table is built
+
+
+@pytest.mark.slow
+def test_a_100_by_100_map_loads():
+    text = "\n".join(["S" + "." * 99] + ["." * 100] * 99)
+    spec = parse_map(text, name="big")
+    assert spec.dist.shape == (10_000, 10_000) and spec.cell_distance(0, 9999) == 198

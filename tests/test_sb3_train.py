@@ -283,3 +283,24 @@ def test_tiny_rollouts_train_without_nan(tmp_path):
                 progress_bar=False)
     model = MaskableRecurrentPPO.load(run / "model.zip", device="cpu")
     assert all(th.isfinite(p).all() for p in model.policy.parameters())
+
+
+def test_resume_trims_the_curve_and_eval_to_the_checkpoint_and_reads_a_cut_cpu_line(tmp_path):
+    """A run killed after its checkpoint left curve/eval rows past it and a cut cpu_time line:
+    --resume drops them, so the curve's steps never go back and no step appears twice."""
+    run = train(map=ROOM, timesteps=800, out=tmp_path, hyperparams=tiny_hp(eval_freq=400, eval_episode_steps=3,
+                                                                            checkpoint_freq=400),
+                progress_bar=False)
+    (run / "checkpoints" / "model_800_steps.zip").unlink()              # the kill came before this checkpoint
+    (run / "model.zip").unlink()
+    with (run / "curve.csv").open("a") as f:
+        f.write("9999,1,0.0,1,1,0,0,5\n1000,2,0.")                     # a stretch past the checkpoint, a cut line
+    with (run / "cpu_time.csv").open("a") as f:
+        f.write("12")
+    train(map=ROOM, timesteps=1200, out=tmp_path, hyperparams=tiny_hp(eval_freq=400, eval_episode_steps=3,
+                                                                       checkpoint_freq=400),
+          resume=True, progress_bar=False)
+    steps = [int(r["timesteps"]) for r in read_curve(run / "curve.csv")]
+    assert steps == sorted(steps) and 9999 not in steps and max(steps) <= 1200
+    evals = [(int(r["timesteps"]), r["n_agents"]) for r in read_curve(run / "eval.csv")]
+    assert len(evals) == len(set(evals))

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from collections import deque
 from pathlib import Path
 
 import numpy as np
@@ -41,6 +40,10 @@ def _shipped_maps_dir() -> Path:
 
 
 MAPS_DIR = _shipped_maps_dir()
+
+MAX_FREE_CELLS = 10_000
+"""Largest map accepted, in free cells (a 100 x 100 open map: ~0.5 GB of distance tables, about
+10-20 s to build on one core); a larger one is refused at once."""
 
 
 class MapError(ValueError):
@@ -226,6 +229,10 @@ def parse_map(text: str, name: str = "custom", source: str = "<string>") -> MapS
     free_cells = np.flatnonzero(flat != OBSTACLE).astype(np.int64)
     free_index = np.full(n_cells, -1, dtype=np.int64)
     free_index[free_cells] = np.arange(len(free_cells))
+    if len(free_cells) > MAX_FREE_CELLS:
+        raise MapError(f"{source}: {len(free_cells):,} free cells; the limit is {MAX_FREE_CELLS:,} (the "
+                       f"all-pairs distance tables take 5 bytes per pair of free cells: "
+                       f"{5 * len(free_cells) ** 2 / 1e9:.1f} GB here)")
     dist, next_action = _all_pairs_bfs(free_cells, free_index, neighbour, move_ok)
 
     unreachable = dist[free_index[stations[0]]] < 0
@@ -251,34 +258,38 @@ def parse_map(text: str, name: str = "custom", source: str = "<string>") -> MapS
 
 
 def _all_pairs_bfs(free_cells, free_index, neighbour, move_ok):
-    """BFS from every free cell. Returns dist (F, F) int32 (-1 unreachable) and the first
-    action of a shortest path next_action (F, F) int8 (ties broken by action order)."""
+    """Shortest paths between all free cells (scipy's breadth-first search over the grid graph, in
+    chunks of sources). Returns dist (F, F) int32 (-1 unreachable) and the first action of a
+    shortest path next_action (F, F) int8 (ties broken by action order)."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import shortest_path
     n_free = len(free_cells)
-    dist = np.full((n_free, n_free), -1, dtype=np.int32)
+    src, dst = [], []
+    for a in range(4):
+        ok = move_ok[free_cells, a]
+        src.append(np.flatnonzero(ok))
+        dst.append(free_index[neighbour[free_cells[ok], a]])
+    src, dst = np.concatenate(src), np.concatenate(dst)
+    graph = csr_matrix((np.ones(len(src), dtype=np.int8), (src, dst)), shape=(n_free, n_free))
+    dist = np.empty((n_free, n_free), dtype=np.int32)
+    chunk = max(1, 2_000_000 // max(n_free, 1))                # ~16 MB of float64 per chunk
+    for start in range(0, n_free, chunk):
+        rows = shortest_path(graph, method="D", directed=True, unweighted=True,
+                             indices=np.arange(start, min(start + chunk, n_free)))
+        dist[start:start + len(rows)] = np.where(np.isinf(rows), -1, rows).astype(np.int32)
     # first action from a toward b = an action whose neighbour n has dist[n, b] == dist[a, b] - 1
-    for i, start in enumerate(free_cells):
-        dist[i, i] = 0
-        queue = deque([int(start)])
-        while queue:
-            cell = queue.popleft()
-            d = dist[i, free_index[cell]]
-            for a in range(4):
-                if move_ok[cell, a]:
-                    n = int(neighbour[cell, a])
-                    j = free_index[n]
-                    if dist[i, j] < 0:
-                        dist[i, j] = d + 1
-                        queue.append(n)
     next_action = np.full((n_free, n_free), 4, dtype=np.int8)
     nb_free = free_index[neighbour[free_cells]]  # (F, 5) free index of each neighbour
-    best = np.full((n_free, n_free), np.iinfo(np.int32).max, dtype=np.int64)
+    big = np.iinfo(np.int32).max
+    best = np.full((n_free, n_free), big, dtype=np.int32)
     for a in range(3, -1, -1):  # later actions first so that the lowest action index wins ties
         ok = move_ok[free_cells, a]
-        d_nb = np.where(ok[:, None], dist[nb_free[:, a]].astype(np.int64), np.iinfo(np.int32).max)
-        d_nb = np.where(d_nb < 0, np.iinfo(np.int32).max, d_nb)
+        d_nb = np.where(ok[:, None], dist[nb_free[:, a]], big)
+        d_nb[d_nb < 0] = big
         better = d_nb <= best
-        best = np.where(better, d_nb, best)
-        next_action = np.where(better & (d_nb < dist), a, next_action).astype(np.int8)
+        np.copyto(best, d_nb, where=better)
+        next_action[better & (d_nb < dist)] = a
+        del d_nb, better
     np.fill_diagonal(next_action, 4)
     next_action[dist < 0] = 4
     return dist, next_action

@@ -12,6 +12,7 @@ which is what ``patrolsb3 zoo export`` records as the entry's budget.
 from __future__ import annotations
 
 import csv
+import os
 import time
 from pathlib import Path
 
@@ -27,8 +28,14 @@ def read_rows(run_dir) -> list[tuple[int, float]]:
     path = Path(run_dir) / CPU_TIME_FILE
     if not path.is_file():
         return []
+    rows = []
     with path.open(newline="") as f:
-        return [(int(r["timesteps"]), float(r["cpu_seconds"])) for r in csv.DictReader(f)]
+        for r in csv.DictReader(f):
+            try:
+                rows.append((int(r["timesteps"]), float(r["cpu_seconds"])))
+            except (TypeError, ValueError):        # a line cut by a kill: left out
+                continue
+    return rows
 
 
 def cpu_seconds_at(run_dir, timesteps: int) -> float | None:
@@ -44,10 +51,12 @@ def restart_at(run_dir, timesteps: int) -> float:
     rows = [(t, s) for t, s in read_rows(run_dir) if t <= timesteps]
     path = Path(run_dir) / CPU_TIME_FILE
     if path.is_file():
-        with path.open("w", newline="") as f:
+        partial = path.with_name(f".{CPU_TIME_FILE}.partial")
+        with partial.open("w", newline="") as f:
             writer = csv.writer(f)
             writer.writerow(FIELDS)
             writer.writerows(rows)
+        os.replace(partial, path)
     return rows[-1][1] if rows else 0.0
 
 

@@ -29,7 +29,7 @@ import yaml
 from stable_baselines3.common.callbacks import CheckpointCallback
 from stable_baselines3.common.vec_env import VecNormalize
 
-from ..runs import is_valid_model_file, read_config  # noqa: F401  (re-exported)
+from ..runs import is_valid_model_file, read_config, trim_rows  # noqa: F401  (re-exported)
 from .algorithms import DEFAULT_ALGORITHM, get_algorithm, torch_device
 from .cpu_time import cpu_hours_of
 from .curriculum import CURRICULUM, curriculum_stage
@@ -436,6 +436,8 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
         model = cls.load(checkpoint, env=vec_env, device=device, tensorboard_log=str(run_dir / "tb"),
                          verbose=verbose)
         model._last_obs = None  # the saved observation belongs to the old env: learn() resets
+        for name in ("curve.csv", "eval.csv"):    # the abandoned stretch after the checkpoint goes
+            trim_rows(run_dir / name, model.num_timesteps)
         if verbose:
             print(f"resuming {run_dir} from {checkpoint.name} at {model.num_timesteps} timesteps")
     else:
