@@ -165,3 +165,23 @@ def test_batched_core_equals_the_pettingzoo_env_step_for_step(map_name, comm):
         if any(terms.values()):
             break
     assert n_sim_steps >= 50 and events > 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("map_name", ["A", "B", "C", "D"])
+def test_invariants_over_a_million_steps_per_map(map_name):
+    """1,000 episodes x 1,000 steps of stress settings (pushes, short batteries, faults): the
+    cheap invariants every step, the full check every 50 (run with ``pytest -m slow``)."""
+    spec = load_map(map_name)
+    cfg = make_config(map_name, **{**STRESS, "fault_prob": 1e-4})
+    rng = np.random.default_rng(1)
+    state = reset_state(spec, cfg, np.arange(1000) % 5 + 1, n_envs=1000, seed=1)
+    kinds = spec.kinds.ravel()
+    for t in range(1000):
+        mask = action_mask(spec, state)
+        info = step(spec, cfg, state, wandering_moves(spec, state, mask, rng))
+        assert (state.battery >= 0).all() and (state.battery <= cfg.b_max).all()
+        assert (kinds[state.pos] != OBSTACLE).all() and np.isfinite(info.reward).all()
+        assert (info.collisions <= info.collided.sum(axis=1)).all()
+        if t % 50 == 0:
+            check_invariants(spec, cfg, state, info)
