@@ -51,6 +51,16 @@ def add_arguments(parser):
     p_lis.add_argument("--seed", type=int, default=1000, help="seed (default 1000; the zoo's eval uses 0)")
 
 
+def relative_path(path) -> str:
+    """``path`` relative to the working folder when it lies under it, else its last three parts."""
+    from pathlib import Path
+    path = Path(path).resolve()
+    try:
+        return str(path.relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(Path(*path.parts[-3:]))
+
+
 def headline(entry: dict) -> str:
     """Short text of an entry's evaluation: MAX and AVG idleness, collisions, BF rate per n."""
     from ..report import clean_figures
@@ -86,7 +96,9 @@ def run(args):
         print(json.dumps({"entry": f"{args.map.upper()}/{args.variant}", **figures}))
         return 0
     if args.zoo_command == "show":
-        print(json.dumps(read_entry(entry_dir(args.map, args.variant, args.zoo_dir)), indent=2, default=str))
+        entry = read_entry(entry_dir(args.map, args.variant, args.zoo_dir))
+        entry["path"] = relative_path(entry["path"])      # no path of this machine in the output
+        print(json.dumps(entry, indent=2, default=str))
         return 0
     entries = list_entries(args.zoo_dir)
     if not entries:
