@@ -59,7 +59,6 @@ def trim_rows(path, timesteps: int) -> int:
     checkpoint a resume starts from), dropping a cut last line; rewritten atomically. Returns the
     rows kept (0 when the file does not exist)."""
     import csv
-    import os
     path = Path(path)
     if not path.is_file():
         return 0
@@ -76,10 +75,27 @@ def trim_rows(path, timesteps: int) -> int:
                     kept.append(row)
             except ValueError:          # a line cut by a kill
                 continue
-    partial = path.with_name(f".{path.name}.partial")
-    with partial.open("w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow(header)
-        writer.writerows(kept)
-    os.replace(partial, path)
+    def write(partial: Path) -> None:
+        with partial.open("w", newline="") as f:
+            writer = csv.writer(f)
+            writer.writerow(header)
+            writer.writerows(kept)
+    write_atomically(path, write)
     return len(kept)
+
+
+def write_atomically(path, write, suffix: str = "") -> Path:
+    """``write(partial_path)`` under a temporary name beside ``path``, then a rename over it: a
+    kill during the write leaves the old file (or none), never a cut one.
+
+    Args:
+        path: the file to (re)write.
+        write: a function that writes the whole file at the path it is given.
+        suffix: appended to the temporary name (``.zip`` for writers that add it otherwise).
+    """
+    import os
+    path = Path(path)
+    partial = path.with_name(f".{path.name}.partial{suffix}")
+    write(partial)
+    os.replace(partial, path)
+    return path

@@ -23,7 +23,7 @@ def card(entry: dict) -> str:
              f"- **variant**: `{c.get('variant')}`, {VARIANT_TEXT.get(c.get('variant'), '')}",
              f"- **algorithm**: {c.get('algo')} (patrolsb3, Stable-Baselines3 / sb3-contrib), env "
              f"`{c.get('env_version')}`, trained {c.get('date', '?')}",
-             f"- **setting**: " + ("**behind the return guard** (`env.return_guard`, ours: the heuristics' "
+             "- **setting**: " + ("**behind the return guard** (`env.return_guard`, ours: the heuristics' "
                                    "recharge rule as a shield on the moves; not the paper's setting)"
                                    if guarded else "the paper's setting (no return guard)"),
              f"- **observation**: messages `{env.get('message_encoding', 'scalar')}`, local idleness "
@@ -32,7 +32,7 @@ def card(entry: dict) -> str:
              f"{budget.get('cpu_hours', '?')} CPU hours; {PAPER_BUDGET}",
              f"- **seeds**: one (training seed {c.get('seed')}); no spread over seeds yet", ""]
     if ev:
-        lines += [f"## Evaluation", "",
+        lines += ["## Evaluation", "",
                   f"{ev.get('tests')} test x {ev.get('episodes')} episodes x {ev.get('steps')} steps per "
                   f"team size, seed {ev.get('seed')}, "
                   f"{'most likely legal action' if ev.get('deterministic', True) else 'sampled actions'}; "

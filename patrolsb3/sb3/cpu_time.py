@@ -12,7 +12,6 @@ which is what ``patrolsb3 zoo export`` records as the entry's budget.
 from __future__ import annotations
 
 import csv
-import os
 import time
 from pathlib import Path
 
@@ -48,15 +47,9 @@ def cpu_seconds_at(run_dir, timesteps: int) -> float | None:
 def restart_at(run_dir, timesteps: int) -> float:
     """Cut ``cpu_time.csv`` back to ``timesteps`` (a resume from that checkpoint) and return the
     CPU seconds spent up to there (0 for a run without a record)."""
-    rows = [(t, s) for t, s in read_rows(run_dir) if t <= timesteps]
-    path = Path(run_dir) / CPU_TIME_FILE
-    if path.is_file():
-        partial = path.with_name(f".{CPU_TIME_FILE}.partial")
-        with partial.open("w", newline="") as f:
-            writer = csv.writer(f)
-            writer.writerow(FIELDS)
-            writer.writerows(rows)
-        os.replace(partial, path)
+    from ..runs import trim_rows
+    trim_rows(Path(run_dir) / CPU_TIME_FILE, timesteps)
+    rows = read_rows(run_dir)
     return rows[-1][1] if rows else 0.0
 
 

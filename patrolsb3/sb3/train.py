@@ -18,7 +18,6 @@ in the hyperparameters and converted per env step (``gamma ** (1 / phases_per_st
 from __future__ import annotations
 
 import json
-import os
 import re
 import sys
 import zipfile
@@ -29,7 +28,7 @@ import yaml
 from stable_baselines3.common.callbacks import CheckpointCallback
 from stable_baselines3.common.vec_env import VecNormalize
 
-from ..runs import is_valid_model_file, read_config, trim_rows  # noqa: F401  (re-exported)
+from ..runs import is_valid_model_file, read_config, trim_rows, write_atomically  # noqa: F401  (re-exported)
 from .algorithms import DEFAULT_ALGORITHM, get_algorithm, torch_device
 from .cpu_time import cpu_hours_of
 from .curriculum import CURRICULUM, curriculum_stage
@@ -90,20 +89,12 @@ def newest_checkpoint(run_dir: Path, skipped: list | None = None) -> Path | None
 def save_atomically(model, path) -> Path:
     """``model.save`` under a temporary name beside ``path``, then a rename: a kill during the
     write leaves no file with the checkpoint's name."""
-    path = Path(path)
-    partial = path.with_name(f".{path.stem}.partial.zip")
-    model.save(partial)
-    os.replace(partial, path)
-    return path
+    return write_atomically(path, model.save, suffix=".zip")
 
 
 def save_statistics_atomically(vec_normalize, path) -> Path:
     """``VecNormalize.save`` the same way (temporary name, then a rename)."""
-    path = Path(path)
-    partial = path.with_name(f".{path.name}.partial")
-    vec_normalize.save(str(partial))
-    os.replace(partial, path)
-    return path
+    return write_atomically(path, lambda partial: vec_normalize.save(str(partial)))
 
 
 class AtomicCheckpointCallback(CheckpointCallback):
