@@ -59,9 +59,17 @@ def zoo_root(zoo_dir=None) -> Path:
 VARIANT_NAMES = ("rl-msg", "rl-no-msg", "rl-intention")
 
 
-def entry_dir(map_name: str, variant: str, zoo_dir=None) -> Path:
-    """Folder of one zoo entry (it need not exist)."""
-    return zoo_root(zoo_dir) / str(map_name).upper() / variant
+def entry_dir(map_name: str, variant: str, zoo_dir=None, seed: int | None = None) -> Path:
+    """Folder of one zoo entry (it need not exist): ``<zoo>/<MAP>/<variant>``, the default (the
+    seed chosen by validation), or its ``seed<k>`` subfolder for one training seed."""
+    folder = zoo_root(zoo_dir) / str(map_name).upper() / variant
+    return folder if seed is None else folder / f"seed{int(seed)}"
+
+
+def seeds(map_name: str, variant: str, zoo_dir=None) -> list[int]:
+    """The training seeds an entry holds besides its default (``seed<k>`` subfolders)."""
+    folder = entry_dir(map_name, variant, zoo_dir)
+    return sorted(int(p.parent.name[4:]) for p in folder.glob("seed*/model.zip") if p.parent.name[4:].isdigit())
 
 
 def read_entry(path: Path) -> dict:
@@ -285,7 +293,8 @@ def load_checkpoint(path, spec=None) -> ZooPolicy:
     return ZooPolicy(model.policy, spec, env_config(config), info)
 
 
-def load(map_name: str, variant: str, zoo_dir=None, spec=None, device: str = "cpu") -> ZooPolicy:
+def load(map_name: str, variant: str, zoo_dir=None, spec=None, device: str = "cpu",
+         seed: int | None = None) -> ZooPolicy:
     """Load a zoo model ready to act: ``patrolsb3.zoo.load("A", "rl-msg")``.
 
     Args:
@@ -294,15 +303,20 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None, device: str = "cp
         zoo_dir: another zoo folder (default: the repository's ``zoo/``).
         spec: the map to act on (default: ``map_name``); must match the training map's size.
         device: where the network runs: "cpu" (default), "cuda" or "auto".
+        seed: one training seed's model (``zoo/<MAP>/<variant>/seed<k>``); None: the entry's
+            default, the seed chosen by validation.
 
     Raises:
-        ZooError: no such entry (lists what the zoo has), or a checkpoint trained for another
-            env version or map size.
+        ZooError: no such entry or seed (lists what the zoo has), or a checkpoint trained for
+            another env version or map size.
         ValueError: a device torch cannot use.
     """
     if variant not in VARIANT_NAMES:
         raise ZooError(f"unknown variant {variant!r}; known: {', '.join(VARIANT_NAMES)}")
-    folder = entry_dir(map_name, variant, zoo_dir)
+    folder = entry_dir(map_name, variant, zoo_dir, seed)
+    if seed is not None and not (folder / "model.zip").is_file():
+        raise ZooError(f"no seed {seed} of {str(map_name).upper()}/{variant} (looked for {folder / 'model.zip'}); "
+                       f"its seeds: {seeds(map_name, variant, zoo_dir) or 'none besides the default'}")
     if not (folder / "model.zip").is_file():
         have = [f"{Path(e['path']).parent.name}/{Path(e['path']).name}" for e in list_entries(zoo_dir)]
         raise ZooError(f"no zoo model for map {str(map_name).upper()} variant {variant} "
@@ -335,7 +349,7 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None, device: str = "cp
     return ZooPolicy(policy, spec, cfg, info)
 
 
-def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None) -> Path:
+def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, as_seed: bool = False) -> Path:
     """Copy a training run into the zoo, keeping the policy only (no optimizer).
 
     Args:
@@ -347,9 +361,11 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None) -
         budget: extra facts about the training budget, stored in config.yml. Without
             ``cpu_hours`` in it, the CPU hours the run measured (``cpu_time.csv``, its
             warm-start stages included) are recorded, when every stage measured them.
+        as_seed: write into the entry's ``seed<k>`` subfolder (k: the run's training seed)
+            instead of its default folder; ``load(map, variant, seed=k)`` reads it.
 
     Returns:
-        The entry folder ``zoo/<map>/<variant>/``.
+        The entry folder ``zoo/<map>/<variant>/`` (or its ``seed<k>``).
 
     Raises:
         ZooError: the run folder lacks a model or a config.
@@ -369,7 +385,7 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None) -
     from .sb3.algorithms import get_algorithm
     algo_class, _ = get_algorithm(config["algo"]).classes()
     model = algo_class.load(str(source), device="cpu")
-    folder = entry_dir(config["map"], config["variant"], zoo_dir)
+    folder = entry_dir(config["map"], config["variant"], zoo_dir, seed=config.get("seed", 0) if as_seed else None)
     folder.mkdir(parents=True, exist_ok=True)
     model.policy.save(str(folder / "model.zip"))
     for name in ("command.txt", "curve.csv", "eval.csv", "cpu_time.csv"):
@@ -419,7 +435,9 @@ def write_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0, te
     from .evaluate import run_episodes, summarize
     folder = Path(folder)
     config = read_entry(folder)["config"]
-    policy = load(config["map"], config["variant"], zoo_dir=folder.parent.parent)
+    seed_folder = folder.name.startswith("seed") and folder.parent.name == config["variant"]
+    policy = load(config["map"], config["variant"], zoo_dir=folder.parents[2] if seed_folder else folder.parents[1],
+                  seed=int(folder.name[4:]) if seed_folder else None)
     max_agents = policy.cfg.max_agents
     cfg = evaluation_config(policy, steps)
     per_size = episodes * tests

@@ -13,6 +13,16 @@ PAPER_BUDGET = ("the paper's budget, as we read it: 1,500 episodes of 5,000 simu
                 "parallel, i.e. 7.5 M simulator steps of episodes (~15-18 M agent decisions with messages)")
 
 
+def simulator_steps(config: dict, agent_steps: int) -> int:
+    """Simulator steps of episodes behind ``agent_steps`` (SB3's count: rows x env steps), for a
+    run of ``n_envs`` parallel episodes with ``max_agents`` rows each and two env steps per
+    simulator step with same-step messages."""
+    env = config.get("env") or {}
+    rows = int((config.get("hyperparams") or {}).get("n_envs", 8)) * int(env.get("max_agents", 5))
+    phases = 2 if env.get("comm", "learned") != "none" and env.get("message_timing", "same_step") == "same_step" else 1
+    return int(agent_steps) // (rows * phases) * int((config.get("hyperparams") or {}).get("n_envs", 8))
+
+
 def card(entry: dict) -> str:
     """The markdown card of one entry (``patrolsb3.zoo.read_entry``'s dict)."""
     c, ev = entry["config"], entry.get("eval") or {}
@@ -28,7 +38,8 @@ def card(entry: dict) -> str:
                                    if guarded else "the paper's setting (no return guard)"),
              f"- **observation**: messages `{env.get('message_encoding', 'scalar')}`, local idleness "
              f"{'on' if env.get('local_idleness') else 'off'}, difference-reward weight c_d = {env.get('c_d')}",
-             f"- **budget**: {int(budget.get('timesteps', 0)):,} agent-steps (all stages), "
+             f"- **budget**: {int(budget.get('timesteps', 0)):,} agent-steps (all stages), about "
+             f"{simulator_steps(c, budget.get('timesteps', 0)):,} simulator steps of episodes, "
              f"{budget.get('cpu_hours', '?')} CPU hours; {PAPER_BUDGET}",
              f"- **seeds**: one (training seed {c.get('seed')}); no spread over seeds yet", ""]
     if ev:

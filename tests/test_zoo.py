@@ -108,8 +108,8 @@ def test_zoo_policy_runs_strict_episodes_and_writes_eval(trained):
 
 
 def test_write_eval_on_every_team_size(trained, monkeypatch):
-    monkeypatch.setattr(zoo, "load", lambda m, v, zoo_dir=None, spec=None, _load=zoo.load:
-                        _load(m, v, zoo_dir=zoo_dir, spec=trained["map_file"]))
+    monkeypatch.setattr(zoo, "load", lambda m, v, zoo_dir=None, spec=None, seed=None, _load=zoo.load:
+                        _load(m, v, zoo_dir=zoo_dir, spec=trained["map_file"], seed=seed))
     path = zoo.write_eval(trained["folder"], episodes=2, steps=30, progress=False)
     data = json.loads(path.read_text())
     assert [r["n_agents"] for r in data["results"]] == [1, 2, 3, 4, 5]
@@ -268,3 +268,17 @@ def test_corrupt_files_and_configs_are_refused_in_one_line(trained, tmp_path):
     binary.write_bytes(b"S..\n.\xff.\n")
     with pytest.raises(MapError, match=r"map.txt:2:2: not a text map"):
         load_map(binary)
+
+
+def test_seeds_of_an_entry_load_by_seed(trained, tmp_path):
+    import shutil
+    copy = tmp_path / "zoo"
+    shutil.copytree(trained["root"] / "zoo", copy)
+    folder = zoo.export(trained["run"], zoo_dir=copy, as_seed=True)
+    assert folder == copy / "ROOM" / "rl-msg" / "seed0"
+    assert zoo.seeds("ROOM", "rl-msg", zoo_dir=copy) == [0]
+    policy = zoo.load("ROOM", "rl-msg", zoo_dir=copy, spec=trained["map_file"], seed=0)
+    assert policy.info["path"].endswith("seed0")
+    with pytest.raises(zoo.ZooError, match="no seed 3 of ROOM/rl-msg"):
+        zoo.load("ROOM", "rl-msg", zoo_dir=copy, spec=trained["map_file"], seed=3)
+    assert [e["config"]["variant"] for e in zoo.list_entries(copy)] == ["rl-msg"]   # seeds are not entries

@@ -28,6 +28,8 @@ def add_arguments(parser):
     p_export.add_argument("--stochastic", action="store_true",
                           help="evaluate with sampled actions (default: the most likely legal action)")
     p_export.add_argument("--no-eval", action="store_true", help="copy only, no eval.json")
+    p_export.add_argument("--as-seed", action="store_true",
+                          help="export into the entry's seed<k> subfolder (k: the run's seed), not its default")
     p_val = sub.add_parser("validate", help="evaluate every checkpoint of a run on a short greedy protocol "
                                             "(its own seed) and rank them: fewest battery failures, then AVG^h")
     p_val.add_argument("run_dir", help="run folder of 'patrolsb3 train'")
@@ -120,7 +122,8 @@ def export_and_evaluate(args) -> int:
     """``patrolsb3 zoo export``: copy the run, then write eval.json (paper metrics, n = 1..5)."""
     from ..zoo import export, write_eval
     budget = {"cpu_hours": args.cpu_hours} if args.cpu_hours is not None else {}
-    folder = export(args.run_dir, zoo_dir=args.zoo_dir, budget=budget, checkpoint=args.checkpoint)
+    folder = export(args.run_dir, zoo_dir=args.zoo_dir, budget=budget, checkpoint=args.checkpoint,
+                    as_seed=args.as_seed)
     print(f"exported to {folder}")
     if not args.no_eval:
         path = write_eval(folder, episodes=args.episodes, steps=args.steps, seed=args.seed,
