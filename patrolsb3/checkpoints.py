@@ -22,7 +22,7 @@ def run_checkpoints(run_dir) -> list[Path]:
     Raises:
         FileNotFoundError: a folder with no checkpoint and no model.zip.
     """
-    from .sb3.train import checkpoints_by_steps, is_valid_model_file, model_steps
+    from .runs import checkpoints_by_steps, is_valid_model_file, model_steps
     run_dir = Path(run_dir)
     paths = []
     for path in checkpoints_by_steps(run_dir):

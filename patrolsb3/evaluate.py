@@ -14,7 +14,9 @@ recharge averages over every swap of the test. The summary is mean and std over 
 from __future__ import annotations
 
 import importlib
+import json
 import warnings
+from pathlib import Path
 
 import numpy as np
 
@@ -263,3 +265,56 @@ def evaluation_setup(map_name, n_agents: int, episodes: int, tests: int, steps: 
     cfg = make_config(spec.name, max_agents=max_agents,
                       episode_steps=steps, faults=tuple(faults), invalid_action="raise", **env)
     return spec, cfg
+
+
+def write_zoo_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0, tests: int = 1,
+               progress: bool = True, deterministic: bool = True) -> Path:
+    """Evaluate a zoo entry for 1..max_agents agents and write ``eval.json`` beside it.
+
+    All team sizes run in one batch (episodes x tests per size) so the policy's forward passes
+    are shared; each size's figures are summarised like ``patrolsb3.evaluate.evaluate`` does,
+    so ``patrolsb3 compare`` can reuse them (:func:`cached_result`).
+
+    Args:
+        folder: the entry folder (``zoo/<map>/<variant>``).
+        episodes: episodes per test and team size.
+        steps: steps per episode (14,400 = the paper's 24 h).
+        seed: simulator seed.
+        tests: tests per team size.
+        progress: progress bar.
+        deterministic: most likely legal actions (True) or sampled ones (False).
+
+    Returns:
+        Path of eval.json: {"map", "strategy", "episodes", "tests", "steps", "seed", "deterministic",
+        "results": [evaluate()-style dict per team size]}.
+    """
+    from .zoo import evaluation_config, load, read_entry
+    folder = Path(folder)
+    config = read_entry(folder)["config"]
+    seed_folder = folder.name.startswith("seed") and folder.parent.name == config["variant"]
+    policy = load(config["map"], config["variant"], zoo_dir=folder.parents[2] if seed_folder else folder.parents[1],
+                  seed=int(folder.name[4:]) if seed_folder else None)
+    max_agents = policy.cfg.max_agents
+    cfg = evaluation_config(policy, steps)
+    per_size = episodes * tests
+    team = np.repeat(np.arange(1, max_agents + 1), per_size)                # (max_agents * per_size,)
+    per_episode = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, progress=progress,
+                               desc=f"zoo {config['map']}/{config['variant']} n=1..{max_agents}",
+                               deterministic=deterministic)
+    strategy = f"zoo:{config['variant']}"
+    results = []
+    for n in range(1, max_agents + 1):
+        rows = team == n
+        part = {k: v[rows] for k, v in per_episode.items() if isinstance(v, np.ndarray)}
+        results.append({"strategy": strategy, "map": config["map"], "n_agents": n, "episodes": episodes,
+                        "tests": tests, "steps": steps, "seed": seed, "faults": [],
+                        "deterministic": bool(deterministic), "env": cfg.to_dict(),
+                        "summary": summarize(part, tests),
+                        "bounds": idleness_lower_bounds(policy.spec.n_vertices, n, steps)})
+    out = {"map": config["map"], "strategy": strategy, "episodes": episodes, "tests": tests,
+           "steps": steps, "seed": seed, "deterministic": bool(deterministic),
+           "note": "all team sizes stepped in one batch; episodes of size n are rows n-1 of the batch",
+           "results": results}
+    path = folder / "eval.json"
+    path.write_text(json.dumps(out, indent=2))
+    return path

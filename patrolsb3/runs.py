@@ -1,13 +1,20 @@
 """Run-folder files read the same way everywhere (config.yml, model zips).
 
-A first piece of the run folder's one owner: ``sb3/train.py`` (resume), ``zoo.py`` (entries,
-checkpoints) and ``checkpoints.py`` read config files and check model files through here.
+A first piece of the run folder's one owner: ``sb3/train.py`` (resume), ``sb3/cpu_time.py``,
+``zoo.py`` (entries, checkpoints) and ``checkpoints.py`` find checkpoints, read config files and
+check model files through here, so none of them imports another for it.
 """
 from __future__ import annotations
 
+import json
+import re
+import zipfile
 from pathlib import Path
 
 import yaml
+
+CHECKPOINT_RE = re.compile(r"model_(\d+)_steps\.zip$")
+"""A checkpoint's file name: ``checkpoints/model_<agent-steps>_steps.zip`` (SB3's CheckpointCallback)."""
 
 
 class ConfigError(ValueError):
@@ -99,3 +106,44 @@ def write_atomically(path, write, suffix: str = "") -> Path:
     write(partial)
     os.replace(partial, path)
     return path
+
+
+def checkpoints_by_steps(run_dir) -> list[Path]:
+    """The checkpoints ``run_dir/checkpoints/model_<steps>_steps.zip``, fewest steps first."""
+    found = sorted((int(m.group(1)), p) for p in (Path(run_dir) / "checkpoints").glob("model_*_steps.zip")
+                   if (m := CHECKPOINT_RE.search(p.name)))
+    return [p for _, p in found]
+
+
+def model_steps(model_path) -> int | None:
+    """Agent-steps a model file was saved at: from a checkpoint's name
+    (``model_<steps>_steps.zip``), else from the SB3 zip's own ``data`` record (a run's
+    ``model.zip``); None when neither tells."""
+    model_path = Path(model_path)
+    if m := CHECKPOINT_RE.search(model_path.name):
+        return int(m.group(1))
+    try:
+        with zipfile.ZipFile(model_path) as archive:
+            return int(json.loads(archive.read("data"))["num_timesteps"])
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
+        return None
+
+
+def newest_checkpoint(run_dir: Path, skipped: list | None = None) -> Path | None:
+    """The valid checkpoint of ``run_dir/checkpoints`` with the most timesteps, or None.
+
+    Args:
+        skipped: a list that receives the newer checkpoints passed over as invalid.
+    """
+    for path in reversed(checkpoints_by_steps(run_dir)):
+        if is_valid_model_file(path):
+            return path
+        if skipped is not None:
+            skipped.append(path)
+    return None
+
+
+def run_folder_of(model_path: Path) -> Path:
+    """The run folder of a model file: ``<run>/checkpoints/model_<steps>_steps.zip`` or ``<run>/model.zip``."""
+    model_path = Path(model_path)
+    return model_path.parent.parent if model_path.parent.name == "checkpoints" else model_path.parent

@@ -264,7 +264,7 @@ def load_checkpoint(path, spec=None) -> ZooPolicy:
     path = Path(path)
     if not path.is_file():
         raise ZooError(f"no checkpoint at {path}")
-    from .sb3.train import run_folder_of
+    from .runs import run_folder_of
     run_dir = run_folder_of(path)
     if not (run_dir / "config.yml").is_file():
         raise ZooError(f"{path}: no config.yml in {run_dir}; give a checkpoint inside a run folder of "
@@ -376,7 +376,7 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
     if not (run_dir / "config.yml").is_file():
         raise ZooError(f"{run_dir}: no config.yml; not a run folder of 'patrolsb3 train'")
     from .sb3.cpu_time import cpu_hours_of
-    from .sb3.train import newest_checkpoint
+    from .runs import newest_checkpoint
     source = Path(checkpoint) if checkpoint else (run_dir / "model.zip" if (run_dir / "model.zip").is_file()
                                                    else newest_checkpoint(run_dir))
     if source is None or not source.is_file():
@@ -408,60 +408,6 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
     config["source_run"] = str(run_dir)
     (folder / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
     return folder
-
-
-def write_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0, tests: int = 1,
-               progress: bool = True, deterministic: bool = True) -> Path:
-    """Evaluate a zoo entry for 1..max_agents agents and write ``eval.json`` beside it.
-
-    All team sizes run in one batch (episodes x tests per size) so the policy's forward passes
-    are shared; each size's figures are summarised like ``patrolsb3.evaluate.evaluate`` does,
-    so ``patrolsb3 compare`` can reuse them (:func:`cached_result`).
-
-    Args:
-        folder: the entry folder (``zoo/<map>/<variant>``).
-        episodes: episodes per test and team size.
-        steps: steps per episode (14,400 = the paper's 24 h).
-        seed: simulator seed.
-        tests: tests per team size.
-        progress: progress bar.
-        deterministic: most likely legal actions (True) or sampled ones (False).
-
-    Returns:
-        Path of eval.json: {"map", "strategy", "episodes", "tests", "steps", "seed", "deterministic",
-        "results": [evaluate()-style dict per team size]}.
-    """
-    from .core.metrics import idleness_lower_bounds
-    from .evaluate import run_episodes, summarize
-    folder = Path(folder)
-    config = read_entry(folder)["config"]
-    seed_folder = folder.name.startswith("seed") and folder.parent.name == config["variant"]
-    policy = load(config["map"], config["variant"], zoo_dir=folder.parents[2] if seed_folder else folder.parents[1],
-                  seed=int(folder.name[4:]) if seed_folder else None)
-    max_agents = policy.cfg.max_agents
-    cfg = evaluation_config(policy, steps)
-    per_size = episodes * tests
-    team = np.repeat(np.arange(1, max_agents + 1), per_size)                # (max_agents * per_size,)
-    per_episode = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, progress=progress,
-                               desc=f"zoo {config['map']}/{config['variant']} n=1..{max_agents}",
-                               deterministic=deterministic)
-    strategy = f"zoo:{config['variant']}"
-    results = []
-    for n in range(1, max_agents + 1):
-        rows = team == n
-        part = {k: v[rows] for k, v in per_episode.items() if isinstance(v, np.ndarray)}
-        results.append({"strategy": strategy, "map": config["map"], "n_agents": n, "episodes": episodes,
-                        "tests": tests, "steps": steps, "seed": seed, "faults": [],
-                        "deterministic": bool(deterministic), "env": cfg.to_dict(),
-                        "summary": summarize(part, tests),
-                        "bounds": idleness_lower_bounds(policy.spec.n_vertices, n, steps)})
-    out = {"map": config["map"], "strategy": strategy, "episodes": episodes, "tests": tests,
-           "steps": steps, "seed": seed, "deterministic": bool(deterministic),
-           "note": "all team sizes stepped in one batch; episodes of size n are rows n-1 of the batch",
-           "results": results}
-    path = folder / "eval.json"
-    path.write_text(json.dumps(out, indent=2))
-    return path
 
 
 def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, steps: int, seed: int,

@@ -110,7 +110,8 @@ def test_zoo_policy_runs_strict_episodes_and_writes_eval(trained):
 def test_write_eval_on_every_team_size(trained, monkeypatch):
     monkeypatch.setattr(zoo, "load", lambda m, v, zoo_dir=None, spec=None, seed=None, _load=zoo.load:
                         _load(m, v, zoo_dir=zoo_dir, spec=trained["map_file"], seed=seed))
-    path = zoo.write_eval(trained["folder"], episodes=2, steps=30, progress=False)
+    from patrolsb3.evaluate import write_zoo_eval
+    path = write_zoo_eval(trained["folder"], episodes=2, steps=30, progress=False)
     data = json.loads(path.read_text())
     assert [r["n_agents"] for r in data["results"]] == [1, 2, 3, 4, 5]
     assert data["steps"] == 30 and data["episodes"] == 2

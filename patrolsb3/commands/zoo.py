@@ -120,13 +120,14 @@ def run(args):
 
 def export_and_evaluate(args) -> int:
     """``patrolsb3 zoo export``: copy the run, then write eval.json (paper metrics, n = 1..5)."""
-    from ..zoo import export, write_eval
+    from ..evaluate import write_zoo_eval
+    from ..zoo import export
     budget = {"cpu_hours": args.cpu_hours} if args.cpu_hours is not None else {}
     folder = export(args.run_dir, zoo_dir=args.zoo_dir, budget=budget, checkpoint=args.checkpoint,
                     as_seed=args.as_seed)
     print(f"exported to {folder}")
     if not args.no_eval:
-        path = write_eval(folder, episodes=args.episodes, steps=args.steps, seed=args.seed,
+        path = write_zoo_eval(folder, episodes=args.episodes, steps=args.steps, seed=args.seed,
                           deterministic=not args.stochastic)
         print(f"evaluation written to {path}")
     return 0

@@ -57,7 +57,7 @@ def cpu_hours_of(model_path) -> float | None:
     """CPU hours spent to train a checkpoint (or a run's model.zip), every warm-start stage
     before it included; None when a part of that chain was not measured (a run older than
     this record, or a source without a figure)."""
-    from .train import model_steps, run_folder_of
+    from ..runs import model_steps, run_folder_of
     run_dir = run_folder_of(model_path)
     steps = model_steps(model_path)
     own = cpu_seconds_at(run_dir, steps) if steps is not None else None

@@ -17,10 +17,7 @@ in the hyperparameters and converted per env step (``gamma ** (1 / phases_per_st
 """
 from __future__ import annotations
 
-import json
-import re
 import sys
-import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +25,8 @@ import yaml
 from stable_baselines3.common.callbacks import CheckpointCallback
 from stable_baselines3.common.vec_env import VecNormalize
 
-from ..runs import is_valid_model_file, read_config, trim_rows, write_atomically  # noqa: F401  (re-exported)
+from ..runs import (CHECKPOINT_RE, checkpoints_by_steps, is_valid_model_file, model_steps,  # noqa: F401
+                    newest_checkpoint, read_config, run_folder_of, trim_rows, write_atomically)
 from .algorithms import DEFAULT_ALGORITHM, get_algorithm, torch_device
 from .cpu_time import cpu_hours_of
 from .curriculum import CURRICULUM, curriculum_stage
@@ -38,7 +36,6 @@ ALGO_KEYS = ("learning_rate", "n_steps", "n_epochs", "gamma", "gae_lambda", "cli
              "vf_coef", "max_grad_norm", "n_minibatches", "batch_size", "policy_kwargs", "target_kl")
 RUN_KEYS = ("algo", "timesteps", "n_envs", "curriculum", "env", "checkpoint_freq", "eval_freq",
             "eval_episode_steps", "eval_episodes", "torch_threads", "normalize_reward", "mix")
-CHECKPOINT_RE = re.compile(r"model_(\d+)_steps\.zip$")
 VECNORMALIZE_FILE = "model_vecnormalize_{}_steps.pkl"
 """Reward-normalisation statistics saved beside each checkpoint (SB3's CheckpointCallback name)."""
 
@@ -49,41 +46,6 @@ def curriculum_teams(n_envs: int, max_agents: int, curriculum=CURRICULUM) -> lis
     width = len(curriculum[0])
     index = [0] if n_envs == 1 else [round(i * (width - 1) / (n_envs - 1)) for i in range(n_envs)]
     return [[min(int(row[i]), max_agents) for i in index] for row in curriculum]
-
-
-def checkpoints_by_steps(run_dir) -> list[Path]:
-    """The checkpoints ``run_dir/checkpoints/model_<steps>_steps.zip``, fewest steps first."""
-    found = sorted((int(m.group(1)), p) for p in (Path(run_dir) / "checkpoints").glob("model_*_steps.zip")
-                   if (m := CHECKPOINT_RE.search(p.name)))
-    return [p for _, p in found]
-
-
-def model_steps(model_path) -> int | None:
-    """Agent-steps a model file was saved at: from a checkpoint's name
-    (``model_<steps>_steps.zip``), else from the SB3 zip's own ``data`` record (a run's
-    ``model.zip``); None when neither tells."""
-    model_path = Path(model_path)
-    if m := CHECKPOINT_RE.search(model_path.name):
-        return int(m.group(1))
-    try:
-        with zipfile.ZipFile(model_path) as archive:
-            return int(json.loads(archive.read("data"))["num_timesteps"])
-    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
-        return None
-
-
-def newest_checkpoint(run_dir: Path, skipped: list | None = None) -> Path | None:
-    """The valid checkpoint of ``run_dir/checkpoints`` with the most timesteps, or None.
-
-    Args:
-        skipped: a list that receives the newer checkpoints passed over as invalid.
-    """
-    for path in reversed(checkpoints_by_steps(run_dir)):
-        if is_valid_model_file(path):
-            return path
-        if skipped is not None:
-            skipped.append(path)
-    return None
 
 
 def save_atomically(model, path) -> Path:
@@ -108,12 +70,6 @@ class AtomicCheckpointCallback(CheckpointCallback):
                 save_statistics_atomically(normalize, self._checkpoint_path("vecnormalize_", extension="pkl"))
             save_atomically(self.model, self._checkpoint_path(extension="zip"))
         return True
-
-
-def run_folder_of(model_path: Path) -> Path:
-    """The run folder of a model file: ``<run>/checkpoints/model_<steps>_steps.zip`` or ``<run>/model.zip``."""
-    model_path = Path(model_path)
-    return model_path.parent.parent if model_path.parent.name == "checkpoints" else model_path.parent
 
 
 def versions() -> dict:
