@@ -332,11 +332,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     from stable_baselines3.common.callbacks import CallbackList
 
     from ..core.maps import load_map, source_label
-    from .callbacks import LearningCurveCallback, PaperMetricsEvalCallback
-    from .cpu_time import CpuTimeCallback, restart_at
-    from .curriculum import CurriculumCallback
     from .variants import variant_overrides
-    from .vec_env import DEFAULT_AGENTS, make_vec_env
 
     spec_map = load_map(map)
     variant_overrides(variant)  # unknown variant -> ValueError listing the known ones
@@ -347,33 +343,68 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     spec = get_algorithm(hp.get("algo", DEFAULT_ALGORITHM))
     total = int(hp["timesteps"])
     torch.set_num_threads(int(hp.get("torch_threads", 1)))
-    env_kwargs = dict(hp.get("env") or {})
-
-    from ..core.config import make_config
-    cfg = make_config(spec_map.name, **variant_overrides(variant), **env_kwargs)
-    n_par = int(hp.get("n_envs", 8))
-    teams = curriculum_teams(n_par, min(cfg.max_agents, spec_map.n_vertices))
-    final_teams = [min(k, cfg.max_agents, spec_map.n_vertices) for k in
-                   (DEFAULT_AGENTS if n_par == len(DEFAULT_AGENTS) else teams[-1])]
-
+    cfg, teams, start_teams = _run_teams(spec_map, variant, hp)
     run_dir = Path(run_dir) if run_dir is not None else \
         Path(out) / spec_map.name / variant / (run_id or f"{spec.name}_seed{seed}")
     config = {"map": spec_map.name, "map_source": source_label(spec_map), "map_shape": list(spec_map.shape),
               "variant": variant, "algo": spec.name, "seed": int(seed), "timesteps": total,
               "env": cfg.to_dict(), "hyperparams": hp, "versions": versions()}
-    checkpoint = None
-    cls, policy_cls = spec.classes()
     if resume and init_from is not None:
         raise ValueError("--init-from starts a new run; --resume continues one: give only one of them")
     warm_weights = None
     if init_from is not None:
-        warm_weights, config["init_from"] = warm_start_weights(init_from, cls, policy_cls)
+        warm_weights, config["init_from"] = warm_start_weights(init_from, *spec.classes())
     if resume:
         checkpoint = _check_resumable(run_dir, config)
     elif run_dir.exists() and any(run_dir.iterdir()):
         raise ValueError(f"run folder {run_dir} exists; pass --resume to continue it or --run-id to start another")
-    start_teams = teams[0] if hp.get("curriculum", True) else final_teams
+    else:
+        checkpoint = None
     check_run_settings(hp, total)
+    model, vec_env = _build_model(spec_map, variant, spec, hp, seed, start_teams, checkpoint, warm_weights,
+                                  config, run_dir, device, verbose)
+    # every setting has been accepted (the model is built): now the run folder is made
+    (run_dir / "checkpoints").mkdir(parents=True, exist_ok=True)
+    if not resume:
+        (run_dir / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
+    with (run_dir / "command.txt").open("a") as f:
+        f.write((command or " ".join(sys.argv)) + "\n")
+    callbacks, curve, cpu_time = _callbacks(spec_map, variant, spec, hp, seed, teams, total, run_dir, model,
+                                            vec_env, resumed=checkpoint is not None)
+    remaining = total - model.num_timesteps
+    try:
+        if remaining > 0:
+            model.learn(remaining, callback=CallbackList(callbacks), reset_num_timesteps=checkpoint is None,
+                        progress_bar=progress_bar, tb_log_name=spec.name)
+    finally:
+        _save_final(model, vec_env, run_dir, cpu_time)
+    save_atomically(model, run_dir / "model.zip")
+    if curve.rows_written == 0 and remaining > 0:
+        print(f"curve.csv: no episode finished in these {remaining:,} agent-steps (episodes last "
+              f"{cfg.episode_steps:,} simulator steps); it holds its header only", file=sys.stderr)
+    return run_dir
+
+
+def _run_teams(spec_map, variant: str, hp: dict):
+    """The run's env config, its curriculum of team sizes and the teams it starts with."""
+    from ..core.config import make_config
+    from .variants import variant_overrides
+    from .vec_env import DEFAULT_AGENTS
+    cfg = make_config(spec_map.name, **variant_overrides(variant), **dict(hp.get("env") or {}))
+    n_par = int(hp.get("n_envs", 8))
+    teams = curriculum_teams(n_par, min(cfg.max_agents, spec_map.n_vertices))
+    final_teams = [min(k, cfg.max_agents, spec_map.n_vertices) for k in
+                   (DEFAULT_AGENTS if n_par == len(DEFAULT_AGENTS) else teams[-1])]
+    return cfg, teams, (teams[0] if hp.get("curriculum", True) else final_teams)
+
+
+def _build_model(spec_map, variant: str, spec, hp: dict, seed: int, start_teams, checkpoint, warm_weights,
+                 config: dict, run_dir: Path, device: str, verbose: int):
+    """The training vec env and the model: loaded from ``checkpoint`` (the run's curve and eval
+    cut back to it), or new (from ``warm_weights`` if given)."""
+    from .vec_env import make_vec_env
+    env_kwargs = dict(hp.get("env") or {})
+    cls, policy_cls = spec.classes()
     vec_env = make_vec_env(spec_map, agents=start_teams, variant=variant, seed=seed, strict=spec.masked,
                            episode_env=mixed_episodes(hp, len(start_teams)), **env_kwargs)  # bad env: no run folder
     rows = vec_env.num_envs
@@ -387,53 +418,53 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
             trim_rows(run_dir / name, model.num_timesteps)
         if verbose:
             print(f"resuming {run_dir} from {checkpoint.name} at {model.num_timesteps} timesteps")
-    else:
-        kwargs = algorithm_kwargs(hp, spec, vec_env.layout, vec_env.phases_per_step, rows)
-        model = cls(policy_cls, vec_env, tensorboard_log=str(run_dir / "tb"), seed=seed, verbose=verbose,
-                    device=device, **kwargs)
-        if warm_weights is not None:
-            try:
-                model.policy.load_state_dict(warm_weights)
-            except RuntimeError as exc:
-                raise ValueError(f"--init-from {config['init_from']['path']}: its network does not match "
-                                 f"this run's (another map size, variant or policy_kwargs?): {exc}") from exc
-    # every setting has been accepted (the model is built): now the run folder is made
-    (run_dir / "checkpoints").mkdir(parents=True, exist_ok=True)
-    if not resume:
-        (run_dir / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
-    with (run_dir / "command.txt").open("a") as f:
-        f.write((command or " ".join(sys.argv)) + "\n")
+        return model, vec_env
+    kwargs = algorithm_kwargs(hp, spec, vec_env.layout, vec_env.phases_per_step, rows)
+    model = cls(policy_cls, vec_env, tensorboard_log=str(run_dir / "tb"), seed=seed, verbose=verbose,
+                device=device, **kwargs)
+    if warm_weights is not None:
+        try:
+            model.policy.load_state_dict(warm_weights)
+        except RuntimeError as exc:
+            raise ValueError(f"--init-from {config['init_from']['path']}: its network does not match "
+                             f"this run's (another map size, variant or policy_kwargs?): {exc}") from exc
+    return model, vec_env
 
+
+def _callbacks(spec_map, variant: str, spec, hp: dict, seed: int, teams, total: int, run_dir: Path, model,
+               vec_env, resumed: bool):
+    """The run's callbacks (curriculum, CPU time, checkpoints, learning curve, evaluation), and
+    the curve and CPU-time ones by name."""
+    from .callbacks import LearningCurveCallback, PaperMetricsEvalCallback
+    from .cpu_time import CpuTimeCallback, restart_at
+    from .curriculum import CurriculumCallback
+    from .vec_env import make_vec_env
+    rows = vec_env.num_envs
     max_agents = vec_env.layout.max_agents
     eval_teams = [k for k in range(1, max_agents + 1) if k <= spec_map.n_vertices] * int(hp.get("eval_episodes", 1))
-    eval_env_kwargs = {**env_kwargs, "episode_steps": int(hp.get("eval_episode_steps", 500))}
+    eval_env_kwargs = {**dict(hp.get("env") or {}), "episode_steps": int(hp.get("eval_episode_steps", 500))}
 
     def make_eval_env():
         return make_vec_env(spec_map, agents=eval_teams, variant=variant, seed=seed + 10_000,
                             strict=spec.masked, **eval_env_kwargs)
 
     curve = LearningCurveCallback(run_dir / "curve.csv", max_agents)
-    cpu_time = CpuTimeCallback(run_dir, restart_at(run_dir, model.num_timesteps) if checkpoint is not None else 0.0)
+    cpu_time = CpuTimeCallback(run_dir, restart_at(run_dir, model.num_timesteps) if resumed else 0.0)
     callbacks = [cpu_time, AtomicCheckpointCallback(save_freq=max(1, int(hp.get("checkpoint_freq", 200_000)) // rows),
-                                    save_path=str(run_dir / "checkpoints"), name_prefix="model",
-                                    save_vecnormalize=True),
+                                                    save_path=str(run_dir / "checkpoints"), name_prefix="model",
+                                                    save_vecnormalize=True),
                  curve,
                  PaperMetricsEvalCallback(make_eval_env, run_dir / "eval.csv", int(hp.get("eval_freq", 0)))]
     if hp.get("curriculum", True):
         callbacks.insert(0, CurriculumCallback(total, curriculum=teams))
-    remaining = total - model.num_timesteps
-    try:
-        if remaining > 0:
-            model.learn(remaining, callback=CallbackList(callbacks), reset_num_timesteps=checkpoint is None,
-                        progress_bar=progress_bar, tb_log_name=spec.name)
-    finally:
-        if isinstance(vec_env, VecNormalize):
-            save_statistics_atomically(vec_env, run_dir / "checkpoints" / VECNORMALIZE_FILE.format(model.num_timesteps))
-        save_atomically(model, run_dir / "checkpoints" / f"model_{model.num_timesteps}_steps.zip")
-        cpu_time.record(model.num_timesteps)
-        vec_env.close()
-    save_atomically(model, run_dir / "model.zip")
-    if curve.rows_written == 0 and remaining > 0:
-        print(f"curve.csv: no episode finished in these {remaining:,} agent-steps (episodes last "
-              f"{cfg.episode_steps:,} simulator steps); it holds its header only", file=sys.stderr)
-    return run_dir
+    return callbacks, curve, cpu_time
+
+
+def _save_final(model, vec_env, run_dir: Path, cpu_time) -> None:
+    """The last checkpoint (and its reward statistics) whatever ended the run, its CPU time, and
+    the env closed."""
+    if isinstance(vec_env, VecNormalize):
+        save_statistics_atomically(vec_env, run_dir / "checkpoints" / VECNORMALIZE_FILE.format(model.num_timesteps))
+    save_atomically(model, run_dir / "checkpoints" / f"model_{model.num_timesteps}_steps.zip")
+    cpu_time.record(model.num_timesteps)
+    vec_env.close()
