@@ -21,11 +21,19 @@ class ConfigError(ValueError):
     """A config.yml that cannot be read (not YAML, not a mapping)."""
 
 
+CONFIG_SCHEMA = {"map": str, "map_source": str, "map_shape": list, "variant": str, "algo": str, "seed": int,
+                 "timesteps": int, "env": dict, "hyperparams": dict, "versions": dict, "init_from": dict,
+                 "env_version": str, "date": str, "source_model": str, "source_run": str, "budget": dict}
+"""The keys a run's (or a zoo entry's) config.yml may hold, with their types: the train's own
+(map .. versions, init_from for a warm start) and those ``zoo export`` adds."""
+
+
 def read_config(path: Path) -> dict:
-    """A config.yml as a dict.
+    """A config.yml as a dict, checked against :data:`CONFIG_SCHEMA`.
 
     Raises:
-        ConfigError: not valid YAML, or not a mapping (names the file and the problem).
+        ConfigError: not valid YAML, not a mapping, a key the schema does not know or a value of
+            the wrong type (names the file and the problem).
     """
     try:
         config = yaml.safe_load(Path(path).read_text())
@@ -35,6 +43,12 @@ def read_config(path: Path) -> dict:
         return {}
     if not isinstance(config, dict):
         raise ConfigError(f"{path}: expected a mapping of settings, got {type(config).__name__}")
+    unknown = sorted(set(config) - set(CONFIG_SCHEMA))
+    if unknown:
+        raise ConfigError(f"{path}: settings this code does not know: {unknown}")
+    for key, kind in CONFIG_SCHEMA.items():
+        if key in config and config[key] is not None and not isinstance(config[key], kind):
+            raise ConfigError(f"{path}: {key} must be of type {kind.__name__}, got {config[key]!r}")
     return config
 
 

@@ -283,3 +283,14 @@ def test_seeds_of_an_entry_load_by_seed(trained, tmp_path):
     with pytest.raises(zoo.ZooError, match="no seed 3 of ROOM/rl-msg"):
         zoo.load("ROOM", "rl-msg", zoo_dir=copy, spec=trained["map_file"], seed=3)
     assert [e["config"]["variant"] for e in zoo.list_entries(copy)] == ["rl-msg"]   # seeds are not entries
+
+
+def test_config_files_are_read_through_a_schema(tmp_path):
+    from patrolsb3.runs import ConfigError, read_config
+    path = tmp_path / "config.yml"
+    path.write_text("map: A\nvariant: rl-msg\nwarp: 9\n")
+    with pytest.raises(ConfigError, match=r"does not know: \['warp'\]"):
+        read_config(path)
+    path.write_text("map: A\nseed: first\n")
+    with pytest.raises(ConfigError, match="seed must be of type int"):
+        read_config(path)
