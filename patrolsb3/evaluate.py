@@ -316,5 +316,7 @@ def write_zoo_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0
            "note": "all team sizes stepped in one batch; episodes of size n are rows n-1 of the batch",
            "results": results}
     path = folder / "eval.json"
-    path.write_text(json.dumps(out, indent=2))
+    from .runs import write_atomically
+    text = json.dumps(out, indent=2)
+    write_atomically(path, lambda partial: partial.write_text(text))
     return path

@@ -21,7 +21,7 @@ import yaml
 from .core import protocol
 from .core.config import ENV_VERSION, EnvConfig, make_config
 from .core.maps import MapSpec, load_map
-from .runs import read_config, zip_is_intact  # noqa: F401  (zoo.read_config is public)
+from .runs import read_config, write_atomically, zip_is_intact  # noqa: F401  (zoo.read_config is public)
 
 
 class ZooError(ValueError):
@@ -387,7 +387,7 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
     model = algo_class.load(str(source), device="cpu")
     folder = entry_dir(config["map"], config["variant"], zoo_dir, seed=config.get("seed", 0) if as_seed else None)
     folder.mkdir(parents=True, exist_ok=True)
-    model.policy.save(str(folder / "model.zip"))
+    write_atomically(folder / "model.zip", lambda partial: model.policy.save(str(partial)), suffix=".zip")
     for name in ("command.txt", "curve.csv", "eval.csv", "cpu_time.csv"):
         if (run_dir / name).is_file():
             shutil.copyfile(run_dir / name, folder / name)
@@ -406,7 +406,8 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
         config["budget"]["timesteps_this_run"] = int(model.num_timesteps)
         config["budget"]["timesteps"] = int(model.num_timesteps) + int(warm)
     config["source_run"] = str(run_dir)
-    (folder / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
+    text = yaml.safe_dump(config, sort_keys=False)
+    write_atomically(folder / "config.yml", lambda partial: partial.write_text(text))
     return folder
 
 

@@ -188,3 +188,16 @@ def test_same_seed_same_episode_for_many_steps(comm, timing):
         assert np.array_equal(g1, g2) and r1 == r2 and c1 == c2 and np.array_equal(b1, b2)
     other = trajectory(6, comm, timing)
     assert not all(np.array_equal(a[0], b[0]) for a, b in zip(one, other))
+
+
+def test_delayed_messages_out_of_range_are_refused_or_repaired_and_obs_stay_in_the_box():
+    strict = patrolsb3.parallel_env("A", n_agents=2, seed=0, comm="learned", message_timing="delayed")
+    obs, infos = strict.reset(seed=0)
+    with pytest.raises(InvalidActionError, match="sent message index 40"):
+        strict.step({"drone_0": (40, STAY), "drone_1": (0, STAY)})
+    lenient = patrolsb3.parallel_env("A", n_agents=2, seed=0, comm="learned", message_timing="delayed",
+                                     invalid_action="stay")
+    lenient.reset(seed=0)
+    obs, *_ = lenient.step({"drone_0": (40, STAY), "drone_1": (-3, STAY)})
+    obs, *_ = lenient.step({"drone_0": (0, STAY), "drone_1": (0, STAY)})
+    assert all(lenient.observation_space(a).contains(o) for a, o in obs.items())

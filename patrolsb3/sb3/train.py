@@ -366,7 +366,8 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     # every setting has been accepted (the model is built): now the run folder is made
     (run_dir / "checkpoints").mkdir(parents=True, exist_ok=True)
     if not resume:
-        (run_dir / "config.yml").write_text(yaml.safe_dump(config, sort_keys=False))
+        text = yaml.safe_dump(config, sort_keys=False)
+        write_atomically(run_dir / "config.yml", lambda partial: partial.write_text(text))
     with (run_dir / "command.txt").open("a") as f:
         f.write((command or " ".join(sys.argv)) + "\n")
     callbacks, curve, cpu_time = _callbacks(spec_map, variant, spec, hp, seed, teams, total, run_dir, model,
