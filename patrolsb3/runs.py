@@ -106,19 +106,27 @@ def trim_rows(path, timesteps: int) -> int:
 
 
 def write_atomically(path, write, suffix: str = "") -> Path:
-    """``write(partial_path)`` under a temporary name beside ``path``, then a rename over it: a
-    kill during the write leaves the old file (or none), never a cut one.
+    """``write(partial_path)`` into a hidden ``.partial/`` folder beside ``path`` under the same
+    file name (so writers that derive content from the name, like torch's zip archives, write
+    the same bytes), then a rename over ``path``: a kill during the write leaves the old file
+    (or none), never a cut one.
 
     Args:
         path: the file to (re)write.
         write: a function that writes the whole file at the path it is given.
-        suffix: appended to the temporary name (``.zip`` for writers that add it otherwise).
+        suffix: unused, kept for callers that name one.
     """
     import os
     path = Path(path)
-    partial = path.with_name(f".{path.name}.partial{suffix}")
+    folder = path.parent / ".partial"
+    folder.mkdir(parents=True, exist_ok=True)
+    partial = folder / path.name
     write(partial)
     os.replace(partial, path)
+    try:
+        folder.rmdir()                  # left only while a write is under way (or was killed)
+    except OSError:
+        pass
     return path
 
 
