@@ -49,7 +49,7 @@ def card(entry: dict) -> str:
                   f"{'most likely legal action' if ev.get('deterministic', True) else 'sampled actions'}; "
                   f"the 95 % bootstrap interval over episodes is in brackets where the evaluation "
                   f"stored one (evaluations before 2026-12-02 did not: rerun `patrolsb3 zoo export` "
-                  f"or `patrolsb3.evaluate.write_zoo_eval` to get them).", "",
+                  f"or `patrolsb3 zoo eval MAP VARIANT` to get them).", "",
                   "| n | " + " | ".join(h for _, h, _ in ZOO_TABLE_METRICS) + " |",
                   "|---" * (1 + len(ZOO_TABLE_METRICS)) + "|"]
         for row in ev.get("results", []):

@@ -294,3 +294,19 @@ def test_config_files_are_read_through_a_schema(tmp_path):
     path.write_text("map: A\nseed: first\n")
     with pytest.raises(ConfigError, match="seed must be of type int"):
         read_config(path)
+
+
+def test_zoo_eval_rewrites_eval_json_with_intervals_and_the_card_shows_them(trained, tmp_path, monkeypatch):
+    import shutil
+
+    from patrolsb3.cli import main
+    from patrolsb3.zoo_cards import card
+    copy = tmp_path / "zoo"
+    shutil.copytree(trained["root"] / "zoo", copy)
+    monkeypatch.setattr(zoo, "load", lambda m, v, zoo_dir=None, spec=None, seed=None, _load=zoo.load:
+                        _load(m, v, zoo_dir=zoo_dir, spec=trained["map_file"], seed=seed))
+    assert main(["zoo", "eval", "ROOM", "rl-msg", "--zoo-dir", str(copy), "--episodes", "3", "--steps", "20"]) == 0
+    entry = zoo.read_entry(copy / "ROOM" / "rl-msg")
+    assert "ci95" in entry["eval"]["results"][0]["summary"]["avg_idleness"]
+    text = card(entry)
+    assert "| 1 | " in text and " [" in text.split("| 1 | ", 1)[1].split("\n")[0]   # intervals in the table

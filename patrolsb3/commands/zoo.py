@@ -38,6 +38,15 @@ def add_arguments(parser):
     p_val.add_argument("--steps", type=int, default=3000, help="steps per episode (default 3000 = 5 h)")
     p_val.add_argument("--seed", type=int, default=7, help="simulator seed (default 7; the zoo's eval uses 0)")
     p_val.add_argument("--last", type=int, default=None, help="only the newest N checkpoints")
+    p_eval = sub.add_parser("eval", help="evaluate an entry again and rewrite its eval.json (1..max_agents "
+                                          "agents, with 95 % intervals over episodes)")
+    p_eval.add_argument("map")
+    p_eval.add_argument("variant")
+    p_eval.add_argument("--zoo-dir", default=None)
+    p_eval.add_argument("--episodes", type=int, default=10, help="episodes per team size (default 10)")
+    p_eval.add_argument("--steps", type=int, default=14400, help="steps per episode (default 14400)")
+    p_eval.add_argument("--seed", type=int, default=0)
+    p_eval.add_argument("--stochastic", action="store_true", help="sampled actions instead of greedy")
     p_cards = sub.add_parser("cards", help="write one model card (markdown) per entry and an index")
     p_cards.add_argument("--out", default="docs/zoo", help="folder of the cards (default docs/zoo)")
     p_cards.add_argument("--zoo-dir", default=None)
@@ -83,6 +92,12 @@ def run(args):
         return export_and_evaluate(args)
     if args.zoo_command == "validate":
         return validate_checkpoints(args)
+    if args.zoo_command == "eval":
+        from ..evaluate import write_zoo_eval
+        path = write_zoo_eval(entry_dir(args.map, args.variant, args.zoo_dir), episodes=args.episodes,
+                              steps=args.steps, seed=args.seed, deterministic=not args.stochastic)
+        print(f"evaluation written to {relative_path(path)}")
+        return 0
     if args.zoo_command == "cards":
         from ..outputs import check_output_dir
         from ..zoo_cards import write_cards
