@@ -105,7 +105,7 @@ def trim_rows(path, timesteps: int) -> int:
     return len(kept)
 
 
-def write_atomically(path, write, suffix: str = "") -> Path:
+def write_atomically(path, write) -> Path:
     """``write(partial_path)`` into a hidden ``.partial/`` folder beside ``path`` under the same
     file name (so writers that derive content from the name, like torch's zip archives, write
     the same bytes), then a rename over ``path``: a kill during the write leaves the old file
@@ -114,7 +114,6 @@ def write_atomically(path, write, suffix: str = "") -> Path:
     Args:
         path: the file to (re)write.
         write: a function that writes the whole file at the path it is given.
-        suffix: unused, kept for callers that name one.
     """
     import os
     path = Path(path)

@@ -387,7 +387,7 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
     model = algo_class.load(str(source), device="cpu")
     folder = entry_dir(config["map"], config["variant"], zoo_dir, seed=config.get("seed", 0) if as_seed else None)
     folder.mkdir(parents=True, exist_ok=True)
-    write_atomically(folder / "model.zip", lambda partial: model.policy.save(str(partial)), suffix=".zip")
+    write_atomically(folder / "model.zip", lambda partial: model.policy.save(str(partial)))
     for name in ("command.txt", "curve.csv", "eval.csv", "cpu_time.csv"):
         if (run_dir / name).is_file():
             shutil.copyfile(run_dir / name, folder / name)

@@ -51,7 +51,7 @@ def curriculum_teams(n_envs: int, max_agents: int, curriculum=CURRICULUM) -> lis
 def save_atomically(model, path) -> Path:
     """``model.save`` under a temporary name beside ``path``, then a rename: a kill during the
     write leaves no file with the checkpoint's name."""
-    return write_atomically(path, model.save, suffix=".zip")
+    return write_atomically(path, model.save)
 
 
 def save_statistics_atomically(vec_normalize, path) -> Path:
