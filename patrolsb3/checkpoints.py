@@ -22,16 +22,16 @@ def run_checkpoints(run_dir) -> list[Path]:
     Raises:
         FileNotFoundError: a folder with no checkpoint and no model.zip.
     """
-    from .runs import checkpoints_by_steps, is_valid_model_file, model_steps
-    run_dir = Path(run_dir)
+    from .runs import RunFolder, is_valid_model_file, model_steps
+    run = RunFolder(run_dir)
     paths = []
-    for path in checkpoints_by_steps(run_dir):
+    for path in run.checkpoints():
         if is_valid_model_file(path):
             paths.append(path)
         else:
             print(f"skipped {path} (empty, cut or corrupt)", file=sys.stderr)
-    if (run_dir / "model.zip").is_file() and model_steps(run_dir / "model.zip") not in map(model_steps, paths):
-        paths.append(run_dir / "model.zip")
+    if run.model_file.is_file() and model_steps(run.model_file) not in map(model_steps, paths):
+        paths.append(run.model_file)
     if not paths:
         raise FileNotFoundError(f"{run_dir}: no checkpoints/model_<steps>_steps.zip and no model.zip; "
                                 f"not a run folder of 'patrolsb3 train'")

@@ -14,7 +14,6 @@ recharge averages over every swap of the test. The summary is mean and std over 
 from __future__ import annotations
 
 import importlib
-import json
 import warnings
 from pathlib import Path
 
@@ -315,8 +314,5 @@ def write_zoo_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0
            "steps": steps, "seed": seed, "deterministic": bool(deterministic),
            "note": "all team sizes stepped in one batch; episodes of size n are rows n-1 of the batch",
            "results": results}
-    path = folder / "eval.json"
-    from .runs import write_atomically
-    text = json.dumps(out, indent=2)
-    write_atomically(path, lambda partial: partial.write_text(text))
-    return path
+    from .outputs import write_json
+    return write_json(folder / "eval.json", out, indent=2)

@@ -1,5 +1,12 @@
-"""Output paths checked before any long work starts: a one-line error naming the argument and
-the cause, instead of a traceback after the work is done."""
+"""Outputs: paths checked before any long work starts (a one-line error naming the argument and
+the cause, instead of a traceback after the work is done), and result files written as
+standard JSON.
+
+JSON results (``results.json`` of a comparison, a zoo entry's ``eval.json``, ``evaluate
+--json``) are strict JSON: a figure that does not exist (the swap battery level of a run with
+no swap, a mean over no clean episode) is NaN in memory and ``null`` on disk, written by
+:func:`write_json` and read back as NaN by :func:`read_results`.
+"""
 from __future__ import annotations
 
 import os
@@ -58,3 +65,30 @@ def strict_json(value):
     if isinstance(value, (list, tuple)):
         return [strict_json(v) for v in value]
     return value
+
+
+def write_json(path, value, indent: int | None = None) -> Path:
+    """``value`` as strict JSON (non-finite floats as null, :func:`strict_json`), written
+    atomically (:func:`patrolsb3.runs.write_atomically`)."""
+    import json
+
+    from .runs import write_atomically
+    text = json.dumps(strict_json(value), indent=indent, allow_nan=False)
+    return write_atomically(path, lambda partial: partial.write_text(text))
+
+
+def _nan_for_null(value):
+    if value is None:
+        return float("nan")
+    if isinstance(value, dict):
+        return {k: _nan_for_null(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_nan_for_null(v) for v in value]
+    return value
+
+
+def read_results(results: list) -> list:
+    """Results read from JSON with their figures as written: a null inside a result's
+    ``summary`` (a figure that did not exist) back to NaN."""
+    return [{**r, "summary": _nan_for_null(r["summary"])} if isinstance(r, dict) and "summary" in r else r
+            for r in results]

@@ -10,10 +10,10 @@ taken from here (their weights can change under the same name): they come from t
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 from .core.config import ENV_VERSION, EnvConfig
+from .outputs import read_results, write_json
 
 PROTOCOL_KEYS = ("strategy", "map", "n_agents", "episodes", "tests", "steps", "seed", "faults", "env")
 """Result fields that must match for a stored result to stand for a new run."""
@@ -57,6 +57,7 @@ class ResultStore:
                 self.results = json.loads(self.path.read_text())
                 if not isinstance(self.results, list):
                     raise ValueError("not a list of results")
+                self.results = read_results(self.results)
             except ValueError as err:
                 raise ValueError(f"{self.path} is not a results file written by 'patrolsb3 compare' "
                                  f"({err}); move it away or choose another --out") from None
@@ -74,6 +75,4 @@ class ResultStore:
         key = protocol(result)
         self.results = [r for r in self.results if protocol(r) != key] + [result]
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = self.path.with_suffix(".json.tmp")
-        tmp.write_text(json.dumps(self.results))
-        os.replace(tmp, self.path)
+        write_json(self.path, self.results)

@@ -1,8 +1,23 @@
-"""Run-folder files read the same way everywhere (config.yml, model zips).
+"""The run folder of ``patrolsb3 train``, owned here: its layout, names and files.
 
-A first piece of the run folder's one owner: ``sb3/train.py`` (resume), ``sb3/cpu_time.py``,
-``zoo.py`` (entries, checkpoints) and ``checkpoints.py`` find checkpoints, read config files and
-check model files through here, so none of them imports another for it.
+Run folder ``<out>/<map>/<variant>/<run_id>/`` (:class:`RunFolder`)::
+
+    model.zip          final model (SB3 zip)
+    checkpoints/       model_<agent-steps>_steps.zip every ``checkpoint_freq`` agent-steps, and
+                       model_vecnormalize_<agent-steps>_steps.pkl (reward statistics) beside each
+    config.yml         env config, map name and shape, hyperparameters, versions (CONFIG_SCHEMA)
+    command.txt        the command line(s) that made / resumed the run
+    curve.csv          one row per finished parallel episode (learning curve)
+    cpu_time.csv       CPU seconds spent by agent-steps reached (``patrolsb3.sb3.cpu_time``)
+    eval.csv           periodic evaluation on the paper metrics at 1..max_agents agents
+    tb/                TensorBoard logs (SB3 logger)
+
+Every file is written atomically (:func:`write_atomically`: a hidden ``.partial/`` copy, then a
+rename), CSV row blocks included (:func:`append_csv_rows`), so a run killed at any moment
+leaves each file whole: as it was before the write, or with the whole block. ``--resume`` takes
+the newest *valid* checkpoint (:meth:`RunFolder.newest_checkpoint`) and cuts the three CSV
+files back to it (:meth:`RunFolder.cut_back_to`). ``sb3/train.py``, ``sb3/cpu_time.py``,
+``sb3/callbacks.py``, ``zoo.py`` and ``checkpoints.py`` reach the folder through here only.
 """
 from __future__ import annotations
 
@@ -75,6 +90,33 @@ def is_valid_model_file(path) -> bool:
         return "data" in archive.namelist()
 
 
+def append_csv_rows(path, fields, rows) -> None:
+    """Append a block of dict rows to a CSV (the header first when the file is new), atomically:
+    the file with the block is written beside it and renamed over it, so a kill leaves the file
+    with the whole block or without it, never a cut line.
+
+    Args:
+        path: the CSV file.
+        fields: its columns (keys of ``rows`` not among them are left out).
+        rows: the rows to append (none: the file is only created with its header).
+    """
+    import csv
+    import shutil
+    path = Path(path)
+
+    def write(partial: Path) -> None:
+        new = not path.is_file()
+        if not new:
+            shutil.copyfile(path, partial)
+        with partial.open("a" if not new else "w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=list(fields), extrasaction="ignore")
+            if new:
+                writer.writeheader()
+            writer.writerows(rows)
+    if rows or not path.is_file():
+        write_atomically(path, write)
+
+
 def trim_rows(path, timesteps: int) -> int:
     """Cut a run's CSV (curve.csv, eval.csv) back to the rows at or before ``timesteps`` (the
     checkpoint a resume starts from), dropping a cut last line; rewritten atomically. Returns the
@@ -129,13 +171,6 @@ def write_atomically(path, write) -> Path:
     return path
 
 
-def checkpoints_by_steps(run_dir) -> list[Path]:
-    """The checkpoints ``run_dir/checkpoints/model_<steps>_steps.zip``, fewest steps first."""
-    found = sorted((int(m.group(1)), p) for p in (Path(run_dir) / "checkpoints").glob("model_*_steps.zip")
-                   if (m := CHECKPOINT_RE.search(p.name)))
-    return [p for _, p in found]
-
-
 def model_steps(model_path) -> int | None:
     """Agent-steps a model file was saved at: from a checkpoint's name
     (``model_<steps>_steps.zip``), else from the SB3 zip's own ``data`` record (a run's
@@ -150,21 +185,144 @@ def model_steps(model_path) -> int | None:
         return None
 
 
-def newest_checkpoint(run_dir: Path, skipped: list | None = None) -> Path | None:
-    """The valid checkpoint of ``run_dir/checkpoints`` with the most timesteps, or None.
+class RunFolder:
+    """The files of one training run (layout in the module docstring): their paths, the
+    checkpoints, config.yml through :data:`CONFIG_SCHEMA`, the CSV records and their cut back
+    on resume.
 
     Args:
-        skipped: a list that receives the newer checkpoints passed over as invalid.
+        path: the run folder (need not exist yet).
     """
-    for path in reversed(checkpoints_by_steps(run_dir)):
-        if is_valid_model_file(path):
-            return path
-        if skipped is not None:
-            skipped.append(path)
-    return None
 
+    CONFIG, MODEL, COMMAND = "config.yml", "model.zip", "command.txt"
+    CURVE, EVAL, CPU_TIME = "curve.csv", "eval.csv", "cpu_time.csv"
+    CHECKPOINTS, TENSORBOARD = "checkpoints", "tb"
+    STATISTICS = "model_vecnormalize_{}_steps.pkl"
+    """Reward-normalisation statistics beside each checkpoint (SB3's CheckpointCallback name)."""
+    RECORDS = (CURVE, EVAL, CPU_TIME)
+    """The CSV files keyed by agent-steps, cut back to the checkpoint a resume starts from."""
 
-def run_folder_of(model_path: Path) -> Path:
-    """The run folder of a model file: ``<run>/checkpoints/model_<steps>_steps.zip`` or ``<run>/model.zip``."""
-    model_path = Path(model_path)
-    return model_path.parent.parent if model_path.parent.name == "checkpoints" else model_path.parent
+    def __init__(self, path):
+        self.path = Path(path)
+
+    def __repr__(self) -> str:
+        return f"RunFolder({str(self.path)!r})"
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, RunFolder) and other.path == self.path
+
+    def __hash__(self) -> int:
+        return hash(self.path)
+
+    @classmethod
+    def of_model(cls, model_path) -> "RunFolder":
+        """The run folder of a model file: ``<run>/checkpoints/model_<steps>_steps.zip`` or
+        ``<run>/model.zip``."""
+        model_path = Path(model_path)
+        return cls(model_path.parent.parent if model_path.parent.name == cls.CHECKPOINTS else model_path.parent)
+
+    # -- paths ---------------------------------------------------------------------------------
+    @property
+    def config_file(self) -> Path:
+        return self.path / self.CONFIG
+
+    @property
+    def model_file(self) -> Path:
+        return self.path / self.MODEL
+
+    @property
+    def command_file(self) -> Path:
+        return self.path / self.COMMAND
+
+    @property
+    def curve_file(self) -> Path:
+        return self.path / self.CURVE
+
+    @property
+    def eval_file(self) -> Path:
+        return self.path / self.EVAL
+
+    @property
+    def cpu_time_file(self) -> Path:
+        return self.path / self.CPU_TIME
+
+    @property
+    def checkpoints_dir(self) -> Path:
+        return self.path / self.CHECKPOINTS
+
+    @property
+    def tensorboard_dir(self) -> Path:
+        return self.path / self.TENSORBOARD
+
+    def checkpoint_file(self, timesteps: int) -> Path:
+        """``checkpoints/model_<timesteps>_steps.zip``."""
+        return self.checkpoints_dir / f"model_{int(timesteps)}_steps.zip"
+
+    def statistics_file(self, timesteps: int) -> Path:
+        """The reward statistics saved with the checkpoint of ``timesteps``."""
+        return self.checkpoints_dir / self.STATISTICS.format(int(timesteps))
+
+    # -- state ---------------------------------------------------------------------------------
+    def has_files(self) -> bool:
+        """True when the folder exists and holds anything (a new run must not write into it)."""
+        return self.path.is_dir() and any(self.path.iterdir())
+
+    def create(self) -> None:
+        """Make the folder and its checkpoints folder."""
+        self.checkpoints_dir.mkdir(parents=True, exist_ok=True)
+
+    def checkpoints(self) -> list[Path]:
+        """The checkpoints ``checkpoints/model_<steps>_steps.zip``, fewest steps first (valid
+        or not)."""
+        found = sorted((int(m.group(1)), p) for p in self.checkpoints_dir.glob("model_*_steps.zip")
+                       if (m := CHECKPOINT_RE.search(p.name)))
+        return [p for _, p in found]
+
+    def newest_checkpoint(self, skipped: list | None = None) -> Path | None:
+        """The valid checkpoint with the most agent-steps, or None.
+
+        Args:
+            skipped: a list that receives the newer checkpoints passed over as invalid (empty,
+                cut or corrupt).
+        """
+        for path in reversed(self.checkpoints()):
+            if is_valid_model_file(path):
+                return path
+            if skipped is not None:
+                skipped.append(path)
+        return None
+
+    def newest_model(self) -> Path | None:
+        """``model.zip`` when the run finished, else its newest valid checkpoint, else None."""
+        return self.model_file if self.model_file.is_file() else self.newest_checkpoint()
+
+    # -- config and command --------------------------------------------------------------------
+    def read_config(self) -> dict:
+        """config.yml, checked (:func:`read_config`); {} when the folder has none."""
+        return read_config(self.config_file) if self.config_file.is_file() else {}
+
+    def write_config(self, config: dict) -> None:
+        """Write config.yml (atomically), refusing keys outside :data:`CONFIG_SCHEMA`."""
+        unknown = sorted(set(config) - set(CONFIG_SCHEMA))
+        if unknown:
+            raise ConfigError(f"{self.config_file}: settings this code does not know: {unknown}")
+        text = yaml.safe_dump(config, sort_keys=False)
+        write_atomically(self.config_file, lambda partial: partial.write_text(text))
+
+    def record_command(self, command: str) -> None:
+        """Append a command line to command.txt (atomically)."""
+        import shutil
+
+        def write(partial: Path) -> None:
+            if self.command_file.is_file():
+                shutil.copyfile(self.command_file, partial)
+            with partial.open("a") as f:
+                f.write(command.rstrip("\n") + "\n")
+        write_atomically(self.command_file, write)
+
+    # -- records -------------------------------------------------------------------------------
+    def cut_back_to(self, timesteps: int) -> None:
+        """Cut curve.csv, eval.csv and cpu_time.csv back to the rows at or before ``timesteps``
+        (the checkpoint a resume starts from): the abandoned stretch after it goes."""
+        for name in self.RECORDS:
+            trim_rows(self.path / name, timesteps)

@@ -21,6 +21,7 @@ import yaml
 from .core import protocol
 from .core.config import ENV_VERSION, EnvConfig, make_config
 from .core.maps import MapSpec, load_map
+from .outputs import read_results
 from .runs import read_config, write_atomically, zip_is_intact  # noqa: F401  (zoo.read_config is public)
 
 
@@ -80,6 +81,8 @@ def read_entry(path: Path) -> dict:
     config = read_config(config_file)
     eval_file = path / "eval.json"
     evaluation = json.loads(eval_file.read_text()) if eval_file.is_file() else None
+    if evaluation:
+        evaluation["results"] = read_results(evaluation.get("results", []))
     return {"path": str(path), "config": config, "eval": evaluation}
 
 
@@ -264,12 +267,13 @@ def load_checkpoint(path, spec=None) -> ZooPolicy:
     path = Path(path)
     if not path.is_file():
         raise ZooError(f"no checkpoint at {path}")
-    from .runs import run_folder_of
-    run_dir = run_folder_of(path)
-    if not (run_dir / "config.yml").is_file():
+    from .runs import RunFolder
+    run = RunFolder.of_model(path)
+    run_dir = run.path
+    if not run.config_file.is_file():
         raise ZooError(f"{path}: no config.yml in {run_dir}; give a checkpoint inside a run folder of "
                        f"'patrolsb3 train'")
-    config = read_config(run_dir / "config.yml")
+    config = run.read_config()
     version = (config.get("versions") or {}).get("env_version")
     if version != ENV_VERSION:
         raise ZooError(f"{run_dir / 'config.yml'}: trained for env version {version!r}, this code is "
@@ -372,23 +376,23 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
     """
     import datetime
     import shutil
-    run_dir = Path(run_dir)
-    if not (run_dir / "config.yml").is_file():
-        raise ZooError(f"{run_dir}: no config.yml; not a run folder of 'patrolsb3 train'")
+    from .runs import RunFolder
     from .sb3.cpu_time import cpu_hours_of
-    from .runs import newest_checkpoint
-    source = Path(checkpoint) if checkpoint else (run_dir / "model.zip" if (run_dir / "model.zip").is_file()
-                                                   else newest_checkpoint(run_dir))
+    run = RunFolder(run_dir)
+    run_dir = run.path
+    if not run.config_file.is_file():
+        raise ZooError(f"{run_dir}: no config.yml; not a run folder of 'patrolsb3 train'")
+    source = Path(checkpoint) if checkpoint else run.newest_model()
     if source is None or not source.is_file():
         raise ZooError(f"{run_dir}: no model.zip and no checkpoint to export")
-    config = read_config(run_dir / "config.yml")
+    config = run.read_config()
     from .sb3.algorithms import get_algorithm
     algo_class, _ = get_algorithm(config["algo"]).classes()
     model = algo_class.load(str(source), device="cpu")
     folder = entry_dir(config["map"], config["variant"], zoo_dir, seed=config.get("seed", 0) if as_seed else None)
     folder.mkdir(parents=True, exist_ok=True)
     write_atomically(folder / "model.zip", lambda partial: model.policy.save(str(partial)))
-    for name in ("command.txt", "curve.csv", "eval.csv", "cpu_time.csv"):
+    for name in (run.COMMAND, *run.RECORDS):
         if (run_dir / name).is_file():
             shutil.copyfile(run_dir / name, folder / name)
     config["env_version"] = config.get("versions", {}).get("env_version", ENV_VERSION)
@@ -418,6 +422,7 @@ def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
     if not path.is_file():
         return None
     data = json.loads(path.read_text())
+    data["results"] = read_results(data.get("results", []))
     if (data.get("episodes"), data.get("steps"), data.get("seed"), data.get("tests"),
             data.get("deterministic", True)) != (episodes, steps, seed, tests, deterministic):
         return None

@@ -8,7 +8,8 @@ import torch
 from patrolsb3 import cli, zoo
 from patrolsb3.checkpoints import rank, run_checkpoints, validate
 from patrolsb3.core import load_map, make_config, reset_state
-from patrolsb3.sb3.train import model_steps, train
+from patrolsb3.runs import model_steps
+from patrolsb3.sb3.train import train
 
 torch.set_num_threads(1)
 

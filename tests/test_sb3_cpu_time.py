@@ -65,8 +65,10 @@ def test_a_chain_with_an_unmeasured_stage_has_no_figure(tmp_path):
     assert "cpu_hours" not in budget
 
 
-def test_restart_at_cuts_the_rows_past_a_checkpoint(tmp_path):
+def test_restart_at_gives_the_seconds_at_the_checkpoint_after_the_cut(tmp_path):
+    from patrolsb3.runs import RunFolder
     (tmp_path / CPU_TIME_FILE).write_text("timesteps,cpu_seconds\n0,0.0\n400,10.0\n800,20.0\n1200,30.0\n")
-    assert restart_at(tmp_path, 800) == 20.0
+    RunFolder(tmp_path).cut_back_to(800)
     assert read_rows(tmp_path) == [(0, 0.0), (400, 10.0), (800, 20.0)]
+    assert restart_at(tmp_path, 800) == 20.0
     assert restart_at(tmp_path / "nothing", 800) == 0.0

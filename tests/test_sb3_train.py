@@ -8,12 +8,14 @@ import torch as th
 import yaml
 
 from patrolsb3.core import parse_map
+from patrolsb3.runs import RunFolder
 from patrolsb3.sb3 import make_vec_env
 from patrolsb3.sb3.evaluation import RandomMaskedPolicy, evaluate
 from patrolsb3.sb3.hyperparams import parse_set, per_phase, schedule
 from patrolsb3.sb3.cpu_time import cpu_hours_of
 from patrolsb3.sb3.maskable_recurrent_ppo import MaskableRecurrentPPO
-from patrolsb3.sb3.train import curriculum_teams, mixed_episodes, newest_checkpoint, train
+from patrolsb3.sb3.train import curriculum_teams, mixed_episodes, train
+
 
 th.set_num_threads(1)
 ROOM = parse_map("S.....\n......\n......\n......", name="room")
@@ -51,12 +53,12 @@ def test_resume_continues_steps_curriculum_and_curve(tmp_path):
     # 40 rows x 10 env steps per rollout = 400 timesteps; episodes of 5 sim steps = 10 env steps.
     run = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
     first_rows = len(read_curve(run / "curve.csv"))
-    assert newest_checkpoint(run).name == "model_400_steps.zip"
+    assert RunFolder(run).newest_checkpoint().name == "model_400_steps.zip"
     # total 2000: at 400 the progress is 0.2 -> stage 1 (teams 1,1,1,1,2,2,3,3), not stage 0
     train(map=ROOM, timesteps=2000, out=tmp_path, hyperparams=tiny_hp(), resume=True, progress_bar=False)
     model = MaskableRecurrentPPO.load(run / "model.zip", device="cpu")
     assert model.num_timesteps == 2000
-    assert newest_checkpoint(run).name == "model_2000_steps.zip"
+    assert RunFolder(run).newest_checkpoint().name == "model_2000_steps.zip"
     rows = read_curve(run / "curve.csv")
     assert len(rows) > first_rows
     resumed_first = [r for r in rows[first_rows:] if int(r["timesteps"]) == 800]
@@ -127,7 +129,8 @@ def test_learns_to_beat_random_on_a_corridor(tmp_path):
 def test_reward_normalisation_saves_and_resumes_its_statistics(tmp_path):
     from stable_baselines3.common.vec_env import VecNormalize
 
-    from patrolsb3.sb3.train import VECNORMALIZE_FILE, normalized_rewards
+    from patrolsb3.sb3.train import normalized_rewards
+    VECNORMALIZE_FILE = RunFolder.STATISTICS
     run = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(normalize_reward=True),
                 progress_bar=False)
     stats_file = run / "checkpoints" / VECNORMALIZE_FILE.format(400)
@@ -136,7 +139,7 @@ def test_reward_normalisation_saves_and_resumes_its_statistics(tmp_path):
     assert not saved.norm_obs and saved.norm_reward
     assert saved.ret_rms.count > 100           # updated at every env step
     # resume loads those statistics instead of starting fresh ones
-    resumed = normalized_rewards(make_vec_env(ROOM, agents=[1] * 8, seed=0), newest_checkpoint(run), gamma=0.9)
+    resumed = normalized_rewards(make_vec_env(ROOM, agents=[1] * 8, seed=0), RunFolder(run).newest_checkpoint(), gamma=0.9)
     assert resumed.ret_rms.count == saved.ret_rms.count
     train(map=ROOM, timesteps=800, out=tmp_path, hyperparams=tiny_hp(normalize_reward=True), resume=True,
           progress_bar=False)
@@ -203,7 +206,7 @@ def test_interrupted_run_saves_a_checkpoint_and_the_cli_says_how_to_resume(tmp_p
     with pytest.raises(KeyboardInterrupt):
         train(map=ROOM, timesteps=2000, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
     run = tmp_path / "room" / "rl-msg" / "MaskableRecurrentPPO_seed0"
-    assert newest_checkpoint(run).name == "model_400_steps.zip" and not (run / "model.zip").exists()
+    assert RunFolder(run).newest_checkpoint().name == "model_400_steps.zip" and not (run / "model.zip").exists()
 
     from patrolsb3 import cli
     from patrolsb3.commands import train as train_command
@@ -238,9 +241,9 @@ def test_resume_passes_over_empty_and_corrupt_checkpoints(tmp_path, capsys):
     bytes fails its CRC: --resume (and zoo export / validate) use the newest valid one, say
     which they passed over, and the writes themselves go through a temporary name."""
     from patrolsb3.checkpoints import run_checkpoints
-    from patrolsb3.sb3.train import is_valid_model_file
+    from patrolsb3.runs import is_valid_model_file
     run = train(map=ROOM, timesteps=800, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
-    good = newest_checkpoint(run)
+    good = RunFolder(run).newest_checkpoint()
     assert good.name == "model_800_steps.zip" and is_valid_model_file(good)
     assert not list((run / "checkpoints").glob(".*partial*"))          # no temporary file left
     (run / "checkpoints" / "model_1200_steps.zip").write_bytes(b"")    # killed at the start of a write
@@ -250,7 +253,7 @@ def test_resume_passes_over_empty_and_corrupt_checkpoints(tmp_path, capsys):
     cut = good.read_bytes()[: len(flipped) // 3]
     (run / "checkpoints" / "model_2000_steps.zip").write_bytes(cut)
     skipped = []
-    assert newest_checkpoint(run, skipped) == good
+    assert RunFolder(run).newest_checkpoint(skipped) == good
     assert [p.name for p in skipped] == ["model_2000_steps.zip", "model_1600_steps.zip", "model_1200_steps.zip"]
     assert good in run_checkpoints(run) and not any(p.name == "model_1600_steps.zip" for p in run_checkpoints(run))
     train(map=ROOM, timesteps=2400, out=tmp_path, hyperparams=tiny_hp(), resume=True, progress_bar=False)

@@ -1,5 +1,4 @@
 """``patrolsb3 evaluate``: one strategy on one map with the paper's metrics (mean +- std over tests)."""
-import json
 
 
 def add_arguments(parser):
@@ -24,7 +23,7 @@ def add_arguments(parser):
 def run(args):
     from ..evaluate import evaluate, parse_faults
     from ..report import evaluation_text
-    from ..outputs import check_output_file, strict_json
+    from ..outputs import check_output_file, write_json
     from ..sb3.algorithms import torch_device
     torch_device(args.device)   # a device torch cannot use: one line, before any work
     if args.json:
@@ -34,8 +33,5 @@ def run(args):
                       progress=not args.no_progress, deterministic=not args.stochastic, device=args.device)
     print(evaluation_text(result))
     if args.json:
-        from pathlib import Path
-        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        with open(args.json, "w") as fh:
-            json.dump(strict_json(result), fh, indent=2, allow_nan=False)   # NaN (no swap) -> null
+        write_json(args.json, result, indent=2)    # strict JSON: NaN (no swap) -> null
     return 0

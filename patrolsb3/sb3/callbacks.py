@@ -1,27 +1,17 @@
 """Callbacks of a training run: the learning curve CSV and the periodic evaluation."""
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
+from ..runs import append_csv_rows as append_rows
 from .evaluation import METRICS, evaluate, summarize
 
 CURVE_FIELDS = ("timesteps", "n_agents", "reward", "mean_idleness", "max_idleness", "collisions",
                 "battery_failures", "sim_steps")
 EVAL_FIELDS = ("timesteps", "n_agents", "episodes") + METRICS
-
-
-def append_rows(path: Path, fields: tuple, rows: list[dict]) -> None:
-    """Append dict rows to a CSV, writing the header when the file is new."""
-    new = not path.exists()
-    with path.open("a", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
-        if new:
-            writer.writeheader()
-        writer.writerows(rows)
 
 
 class LearningCurveCallback(BaseCallback):

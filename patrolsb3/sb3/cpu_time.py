@@ -13,18 +13,18 @@ from __future__ import annotations
 
 import csv
 import time
-from pathlib import Path
 
-import yaml
 from stable_baselines3.common.callbacks import BaseCallback
 
-CPU_TIME_FILE = "cpu_time.csv"
+from ..runs import RunFolder, append_csv_rows, model_steps
+
+CPU_TIME_FILE = RunFolder.CPU_TIME
 FIELDS = ("timesteps", "cpu_seconds")
 
 
 def read_rows(run_dir) -> list[tuple[int, float]]:
     """The rows of ``run_dir/cpu_time.csv`` as (timesteps, cpu_seconds), [] when there is none."""
-    path = Path(run_dir) / CPU_TIME_FILE
+    path = RunFolder(run_dir).cpu_time_file
     if not path.is_file():
         return []
     rows = []
@@ -45,26 +45,22 @@ def cpu_seconds_at(run_dir, timesteps: int) -> float | None:
 
 
 def restart_at(run_dir, timesteps: int) -> float:
-    """Cut ``cpu_time.csv`` back to ``timesteps`` (a resume from that checkpoint) and return the
-    CPU seconds spent up to there (0 for a run without a record)."""
-    from ..runs import trim_rows
-    trim_rows(Path(run_dir) / CPU_TIME_FILE, timesteps)
-    rows = read_rows(run_dir)
-    return rows[-1][1] if rows else 0.0
+    """The CPU seconds a run had spent when it reached ``timesteps`` (the checkpoint a resume
+    starts from; :meth:`RunFolder.cut_back_to` has cut the rows after it), 0 without a record."""
+    seconds = cpu_seconds_at(run_dir, timesteps)
+    return 0.0 if seconds is None else seconds
 
 
 def cpu_hours_of(model_path) -> float | None:
     """CPU hours spent to train a checkpoint (or a run's model.zip), every warm-start stage
     before it included; None when a part of that chain was not measured (a run older than
     this record, or a source without a figure)."""
-    from ..runs import model_steps, run_folder_of
-    run_dir = run_folder_of(model_path)
+    run = RunFolder.of_model(model_path)
     steps = model_steps(model_path)
-    own = cpu_seconds_at(run_dir, steps) if steps is not None else None
+    own = cpu_seconds_at(run.path, steps) if steps is not None else None
     if own is None:
         return None
-    config_file = run_dir / "config.yml"
-    config = (yaml.safe_load(config_file.read_text()) or {}) if config_file.is_file() else {}
+    config = run.read_config()
     earlier = 0.0
     if config.get("init_from"):
         earlier = config["init_from"].get("cpu_hours")
@@ -83,7 +79,7 @@ class CpuTimeCallback(BaseCallback):
 
     def __init__(self, run_dir, offset_seconds: float = 0.0, verbose: int = 0):
         super().__init__(verbose)
-        self.path = Path(run_dir) / CPU_TIME_FILE
+        self.path = RunFolder(run_dir).cpu_time_file
         self.offset = float(offset_seconds)
         rows = read_rows(run_dir)
         self.last_timesteps = rows[-1][0] if rows else -1     # a resume starts at its checkpoint's row
@@ -105,9 +101,5 @@ class CpuTimeCallback(BaseCallback):
         if timesteps <= self.last_timesteps:
             return
         self.last_timesteps = int(timesteps)
-        new = not self.path.exists()
-        with self.path.open("a", newline="") as f:
-            writer = csv.writer(f)
-            if new:
-                writer.writerow(FIELDS)
-            writer.writerow([int(timesteps), round(self.offset + time.process_time() - self.started, 3)])
+        append_csv_rows(self.path, FIELDS, [{"timesteps": int(timesteps),
+                                             "cpu_seconds": round(self.offset + time.process_time() - self.started, 3)}])

@@ -67,7 +67,8 @@ def train_in_stages(map="A", variant: str = "rl-msg", timesteps: int = 10_000_00
         Path: the stage-2 run folder.
     """
     from .hyperparams import merge
-    from .train import model_steps, train
+    from ..runs import RunFolder, model_steps
+    from .train import train
     run_id = run_id or f"seed{seed}"
     first = max(1, round(int(timesteps) * STAGE1_SHARE))
     stages = []
@@ -79,7 +80,8 @@ def train_in_stages(map="A", variant: str = "rl-msg", timesteps: int = 10_000_00
     from ..core.maps import load_map
     name = load_map(map).name
     run1, run2 = out1 / name / variant / run_id, out2 / name / variant / run_id
-    stage1_done = (run1 / "model.zip").is_file() and (model_steps(run1 / "model.zip") or 0) >= first
+    model1 = RunFolder(run1).model_file
+    stage1_done = model1.is_file() and (model_steps(model1) or 0) >= first
     if not stage1_done:
         train(map=map, variant=variant, timesteps=first, seed=seed, out=out1, run_id=run_id,
               resume=resume and run1.exists(), hyperparams=hp1, **train_kwargs)

@@ -1,15 +1,8 @@
 """``train()``: one parameter-shared training run, its run folder, and ``--resume``.
 
-Run folder ``<out>/<map>/<variant>/<run_id>/``::
-
-    model.zip          final model (SB3 zip)
-    checkpoints/       model_<timesteps>_steps.zip every ``checkpoint_freq`` agent-steps
-    config.yml         env config, map name and shape, algorithm hyperparameters, versions
-    command.txt        the command line(s) that made / resumed the run
-    curve.csv          one row per finished parallel episode (learning curve)
-    cpu_time.csv       CPU seconds spent by agent-steps reached (``patrolsb3.sb3.cpu_time``)
-    eval.csv           periodic evaluation on the paper metrics at 1..max_agents agents
-    tb/                TensorBoard logs (SB3 logger)
+The run folder's layout, files and resume rules belong to :class:`patrolsb3.runs.RunFolder`;
+``train()`` checks every setting, builds the model, makes the folder, learns and saves, in
+that order (a setting refused leaves no folder behind).
 
 Timesteps count agent-steps: vec-env rows (parallel episodes x max_agents slots) x env steps
 (two env steps per simulator step with same-step messages). Discounts are per simulator step
@@ -18,26 +11,24 @@ in the hyperparameters and converted per env step (``gamma ** (1 / phases_per_st
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
-import yaml
 from stable_baselines3.common.callbacks import CheckpointCallback
 from stable_baselines3.common.vec_env import VecNormalize
 
-from ..runs import (CHECKPOINT_RE, checkpoints_by_steps, is_valid_model_file, model_steps,  # noqa: F401
-                    newest_checkpoint, read_config, run_folder_of, trim_rows, write_atomically)
+from ..runs import RunFolder, is_valid_model_file, model_steps, write_atomically
 from .algorithms import DEFAULT_ALGORITHM, get_algorithm, torch_device
 from .cpu_time import cpu_hours_of
-from .curriculum import CURRICULUM, curriculum_stage
+from .curriculum import CURRICULUM
 from .hyperparams import load_hyperparams, merge, per_phase, schedule
 
 ALGO_KEYS = ("learning_rate", "n_steps", "n_epochs", "gamma", "gae_lambda", "clip_range", "ent_coef",
              "vf_coef", "max_grad_norm", "n_minibatches", "batch_size", "policy_kwargs", "target_kl")
 RUN_KEYS = ("algo", "timesteps", "n_envs", "curriculum", "env", "checkpoint_freq", "eval_freq",
             "eval_episode_steps", "eval_episodes", "torch_threads", "normalize_reward", "mix")
-VECNORMALIZE_FILE = "model_vecnormalize_{}_steps.pkl"
-"""Reward-normalisation statistics saved beside each checkpoint (SB3's CheckpointCallback name)."""
 
 
 def curriculum_teams(n_envs: int, max_agents: int, curriculum=CURRICULUM) -> list[list[int]]:
@@ -60,16 +51,31 @@ def save_statistics_atomically(vec_normalize, path) -> Path:
 
 
 class AtomicCheckpointCallback(CheckpointCallback):
-    """SB3's CheckpointCallback with atomic writes: the reward statistics first, then the model
-    (a checkpoint whose model file exists has its statistics)."""
+    """SB3's CheckpointCallback with atomic writes under the run folder's names: the reward
+    statistics first, then the model (a checkpoint whose model file exists has its statistics).
+
+    Args:
+        save_freq: calls (vector-env steps) between checkpoints.
+        run: the run folder.
+    """
+
+    def __init__(self, save_freq: int, run: RunFolder, verbose: int = 0):
+        super().__init__(save_freq=save_freq, save_path=str(run.checkpoints_dir), name_prefix="model",
+                         save_vecnormalize=True, verbose=verbose)
+        self.run = run
 
     def _on_step(self) -> bool:
         if self.n_calls % self.save_freq == 0:
-            normalize = self.model.get_vec_normalize_env()
-            if self.save_vecnormalize and normalize is not None:
-                save_statistics_atomically(normalize, self._checkpoint_path("vecnormalize_", extension="pkl"))
-            save_atomically(self.model, self._checkpoint_path(extension="zip"))
+            save_checkpoint(self.model, self.run)
         return True
+
+
+def save_checkpoint(model, run: RunFolder) -> Path:
+    """The model's checkpoint at its agent-steps, its reward statistics first (if any)."""
+    normalize = model.get_vec_normalize_env()
+    if normalize is not None:
+        save_statistics_atomically(normalize, run.statistics_file(model.num_timesteps))
+    return save_atomically(model, run.checkpoint_file(model.num_timesteps))
 
 
 def versions() -> dict:
@@ -175,25 +181,25 @@ def normalized_rewards(vec_env, checkpoint: Path | None, gamma: float):
         gamma: the per-env-step discount (the return whose std scales the rewards).
     """
     if checkpoint is not None:
-        stats = checkpoint.with_name(VECNORMALIZE_FILE.format(CHECKPOINT_RE.search(checkpoint.name).group(1)))
+        stats = RunFolder.of_model(checkpoint).statistics_file(model_steps(checkpoint))
         if stats.is_file():
             return VecNormalize.load(str(stats), vec_env)
     return VecNormalize(vec_env, norm_obs=False, norm_reward=True, gamma=gamma)
 
 
-def _check_resumable(run_dir: Path, config: dict) -> Path:
+def _check_resumable(run: RunFolder, config: dict) -> Path:
     """The newest valid checkpoint of a run folder whose config matches this run's map and env
     (newer invalid ones are named on stderr and passed over)."""
     skipped = []
-    checkpoint = newest_checkpoint(run_dir, skipped)
+    checkpoint = run.newest_checkpoint(skipped)
     for path in skipped:
         print(f"--resume: skipped {path} (empty, cut or corrupt)", file=sys.stderr)
+    run_dir = run.path
     if checkpoint is None:
-        raise FileNotFoundError(f"--resume: no valid checkpoint found in {run_dir / 'checkpoints'} "
+        raise FileNotFoundError(f"--resume: no valid checkpoint found in {run.checkpoints_dir} "
                                 f"(looked for model_<steps>_steps.zip)")
-    saved_file = run_dir / "config.yml"
-    if saved_file.is_file():
-        saved = read_config(saved_file)
+    if run.config_file.is_file():
+        saved = run.read_config()
         for key in ("map", "map_shape", "variant", "algo"):
             if saved.get(key) != config[key]:
                 raise ValueError(f"--resume: {run_dir} was trained with {key}={saved.get(key)!r}, "
@@ -237,10 +243,7 @@ def earlier_stages(model_path: Path) -> int:
     A run records ``init_from.timesteps`` in its config.yml, which already includes the stages
     before it, so a chain of warm starts (stage 1 -> 2 -> 3 ...) adds up to the whole budget.
     """
-    config_file = run_folder_of(model_path) / "config.yml"
-    if not config_file.is_file():
-        return 0
-    return int(((yaml.safe_load(config_file.read_text()) or {}).get("init_from") or {}).get("timesteps") or 0)
+    return int((RunFolder.of_model(model_path).read_config().get("init_from") or {}).get("timesteps") or 0)
 
 
 def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]:
@@ -262,7 +265,7 @@ def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]
     """
     path = Path(init_from)
     if path.is_dir():   # a zoo entry or a finished run: model.zip; a stopped run: its newest checkpoint
-        path = path / "model.zip" if (path / "model.zip").is_file() else (newest_checkpoint(path) or path / "model.zip")
+        path = RunFolder(path).newest_model() or RunFolder(path).model_file
     if not path.is_file():
         raise FileNotFoundError(f"--init-from: no model at {path} (give a checkpoint .zip, a zoo "
                                 f"model.zip or a folder holding model.zip)")
@@ -280,10 +283,7 @@ def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]
     except Exception as exc:  # noqa: BLE001
         errors.append(f"as a {policy_class.__name__}: {type(exc).__name__}: {exc}")
         raise ValueError(f"--init-from: {path} cannot be loaded ({'; '.join(errors)})") from exc
-    budget = {}
-    config_file = path.parent / "config.yml"
-    if config_file.is_file():
-        budget = (yaml.safe_load(config_file.read_text()) or {}).get("budget", {})
+    budget = RunFolder(path.parent).read_config().get("budget") or {}
     return policy.state_dict(), {"path": str(path), "timesteps": budget.get("timesteps"),
                                  "cpu_hours": budget.get("cpu_hours")}
 
@@ -331,21 +331,17 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     import torch
     from stable_baselines3.common.callbacks import CallbackList
 
-    from ..core.maps import load_map, source_label
-    from .variants import variant_overrides
+    from ..core.maps import source_label
 
-    spec_map = load_map(map)
-    variant_overrides(variant)  # unknown variant -> ValueError listing the known ones
     device = torch_device(device)  # a device torch cannot use: one line, before any work
     shortcuts = {k: v for k, v in dict(n_envs=n_envs, eval_freq=eval_freq, checkpoint_freq=checkpoint_freq,
                                        algo=algo, timesteps=timesteps).items() if v is not None}
-    hp = resolve_hyperparams(spec_map.name, hyperparams_file, merge(hyperparams or {}, shortcuts))
-    spec = get_algorithm(hp.get("algo", DEFAULT_ALGORITHM))
-    total = int(hp["timesteps"])
+    settings = resolve_settings(map, variant, merge(hyperparams or {}, shortcuts), hyperparams_file)
+    spec_map, hp, spec, total = settings.map, settings.hyperparams, settings.algorithm, settings.timesteps
+    cfg, teams, start_teams = settings.env, settings.teams, settings.start_teams
     torch.set_num_threads(int(hp.get("torch_threads", 1)))
-    cfg, teams, start_teams = _run_teams(spec_map, variant, hp)
-    run_dir = Path(run_dir) if run_dir is not None else \
-        Path(out) / spec_map.name / variant / (run_id or f"{spec.name}_seed{seed}")
+    run = RunFolder(run_dir if run_dir is not None else
+                    Path(out) / spec_map.name / variant / (run_id or f"{spec.name}_seed{seed}"))
     config = {"map": spec_map.name, "map_source": source_label(spec_map), "map_shape": list(spec_map.shape),
               "variant": variant, "algo": spec.name, "seed": int(seed), "timesteps": total,
               "env": cfg.to_dict(), "hyperparams": hp, "versions": versions()}
@@ -355,22 +351,21 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     if init_from is not None:
         warm_weights, config["init_from"] = warm_start_weights(init_from, *spec.classes())
     if resume:
-        checkpoint = _check_resumable(run_dir, config)
-    elif run_dir.exists() and any(run_dir.iterdir()):
-        raise ValueError(f"run folder {run_dir} exists; pass --resume to continue it or --run-id to start another")
+        checkpoint = _check_resumable(run, config)
+    elif run.has_files():
+        raise ValueError(f"run folder {run.path} exists; pass --resume to continue it or --run-id to start another")
     else:
         checkpoint = None
-    check_run_settings(hp, total)
     model, vec_env = _build_model(spec_map, variant, spec, hp, seed, start_teams, checkpoint, warm_weights,
-                                  config, run_dir, device, verbose)
+                                  config, run, device, verbose)
     # every setting has been accepted (the model is built): now the run folder is made
-    (run_dir / "checkpoints").mkdir(parents=True, exist_ok=True)
-    if not resume:
-        text = yaml.safe_dump(config, sort_keys=False)
-        write_atomically(run_dir / "config.yml", lambda partial: partial.write_text(text))
-    with (run_dir / "command.txt").open("a") as f:
-        f.write((command or " ".join(sys.argv)) + "\n")
-    callbacks, curve, cpu_time = _callbacks(spec_map, variant, spec, hp, seed, teams, total, run_dir, model,
+    run.create()
+    if checkpoint is not None:
+        run.cut_back_to(model.num_timesteps)    # the abandoned stretch after the checkpoint goes
+    else:
+        run.write_config(config)
+    run.record_command(command or " ".join(sys.argv))
+    callbacks, curve, cpu_time = _callbacks(spec_map, variant, spec, hp, seed, teams, total, run, model,
                                             vec_env, resumed=checkpoint is not None)
     remaining = total - model.num_timesteps
     try:
@@ -378,12 +373,47 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
             model.learn(remaining, callback=CallbackList(callbacks), reset_num_timesteps=checkpoint is None,
                         progress_bar=progress_bar, tb_log_name=spec.name)
     finally:
-        _save_final(model, vec_env, run_dir, cpu_time)
-    save_atomically(model, run_dir / "model.zip")
+        _save_final(model, vec_env, run, cpu_time)
+    save_atomically(model, run.model_file)
     if curve.rows_written == 0 and remaining > 0:
         print(f"curve.csv: no episode finished in these {remaining:,} agent-steps (episodes last "
               f"{cfg.episode_steps:,} simulator steps); it holds its header only", file=sys.stderr)
-    return run_dir
+    return run.path
+
+
+@dataclass(frozen=True)
+class Settings:
+    """A run's settings, resolved and checked (:func:`resolve_settings`)."""
+    map: Any                 # MapSpec
+    hyperparams: dict
+    algorithm: Any           # AlgorithmSpec
+    timesteps: int           # total agent-steps
+    env: Any                 # EnvConfig of the run (mixed episodes add their overrides)
+    teams: list              # the curriculum's team sizes, one list per stage
+    start_teams: list        # the team sizes the run starts with
+
+
+def resolve_settings(map, variant: str, hyperparams: dict | None = None, hyperparams_file=None) -> Settings:
+    """Every setting of a run resolved and checked, without building anything: what ``train``
+    refuses before any work (and ``patrolsb3 sweep`` checks for each trial before it starts).
+
+    Raises:
+        ValueError: an unknown map, variant, algorithm or hyperparameter, or a value out of its
+            range (one line naming it).
+        MapError: a map file that cannot be read.
+    """
+    from ..core.config import make_config
+    from ..core.maps import load_map
+    from .variants import variant_overrides
+    spec_map = load_map(map)
+    variant_overrides(variant)  # unknown variant -> ValueError listing the known ones
+    hp = resolve_hyperparams(spec_map.name, hyperparams_file, hyperparams or {})
+    spec = get_algorithm(hp.get("algo", DEFAULT_ALGORITHM))
+    check_run_settings(hp, hp.get("timesteps"))
+    cfg, teams, start_teams = _run_teams(spec_map, variant, hp)
+    for episode_env in mixed_episodes(hp, len(start_teams)).values():     # each mixed setting is valid too
+        make_config(spec_map.name, **{**variant_overrides(variant), **dict(hp.get("env") or {}), **episode_env})
+    return Settings(spec_map, hp, spec, int(hp["timesteps"]), cfg, teams, start_teams)
 
 
 def _run_teams(spec_map, variant: str, hp: dict):
@@ -400,9 +430,9 @@ def _run_teams(spec_map, variant: str, hp: dict):
 
 
 def _build_model(spec_map, variant: str, spec, hp: dict, seed: int, start_teams, checkpoint, warm_weights,
-                 config: dict, run_dir: Path, device: str, verbose: int):
-    """The training vec env and the model: loaded from ``checkpoint`` (the run's curve and eval
-    cut back to it), or new (from ``warm_weights`` if given)."""
+                 config: dict, run: RunFolder, device: str, verbose: int):
+    """The training vec env and the model: loaded from ``checkpoint``, or new (from
+    ``warm_weights`` if given)."""
     from .vec_env import make_vec_env
     env_kwargs = dict(hp.get("env") or {})
     cls, policy_cls = spec.classes()
@@ -412,16 +442,14 @@ def _build_model(spec_map, variant: str, spec, hp: dict, seed: int, start_teams,
     if hp.get("normalize_reward", False):
         vec_env = normalized_rewards(vec_env, checkpoint, per_phase(hp["gamma"], vec_env.phases_per_step))
     if checkpoint is not None:
-        model = cls.load(checkpoint, env=vec_env, device=device, tensorboard_log=str(run_dir / "tb"),
+        model = cls.load(checkpoint, env=vec_env, device=device, tensorboard_log=str(run.tensorboard_dir),
                          verbose=verbose)
         model._last_obs = None  # the saved observation belongs to the old env: learn() resets
-        for name in ("curve.csv", "eval.csv"):    # the abandoned stretch after the checkpoint goes
-            trim_rows(run_dir / name, model.num_timesteps)
         if verbose:
-            print(f"resuming {run_dir} from {checkpoint.name} at {model.num_timesteps} timesteps")
+            print(f"resuming {run.path} from {checkpoint.name} at {model.num_timesteps} timesteps")
         return model, vec_env
     kwargs = algorithm_kwargs(hp, spec, vec_env.layout, vec_env.phases_per_step, rows)
-    model = cls(policy_cls, vec_env, tensorboard_log=str(run_dir / "tb"), seed=seed, verbose=verbose,
+    model = cls(policy_cls, vec_env, tensorboard_log=str(run.tensorboard_dir), seed=seed, verbose=verbose,
                 device=device, **kwargs)
     if warm_weights is not None:
         try:
@@ -432,7 +460,7 @@ def _build_model(spec_map, variant: str, spec, hp: dict, seed: int, start_teams,
     return model, vec_env
 
 
-def _callbacks(spec_map, variant: str, spec, hp: dict, seed: int, teams, total: int, run_dir: Path, model,
+def _callbacks(spec_map, variant: str, spec, hp: dict, seed: int, teams, total: int, run: RunFolder, model,
                vec_env, resumed: bool):
     """The run's callbacks (curriculum, CPU time, checkpoints, learning curve, evaluation), and
     the curve and CPU-time ones by name."""
@@ -449,23 +477,19 @@ def _callbacks(spec_map, variant: str, spec, hp: dict, seed: int, teams, total: 
         return make_vec_env(spec_map, agents=eval_teams, variant=variant, seed=seed + 10_000,
                             strict=spec.masked, **eval_env_kwargs)
 
-    curve = LearningCurveCallback(run_dir / "curve.csv", max_agents)
-    cpu_time = CpuTimeCallback(run_dir, restart_at(run_dir, model.num_timesteps) if resumed else 0.0)
-    callbacks = [cpu_time, AtomicCheckpointCallback(save_freq=max(1, int(hp.get("checkpoint_freq", 200_000)) // rows),
-                                                    save_path=str(run_dir / "checkpoints"), name_prefix="model",
-                                                    save_vecnormalize=True),
+    curve = LearningCurveCallback(run.curve_file, max_agents)
+    cpu_time = CpuTimeCallback(run.path, restart_at(run.path, model.num_timesteps) if resumed else 0.0)
+    callbacks = [cpu_time, AtomicCheckpointCallback(max(1, int(hp.get("checkpoint_freq", 200_000)) // rows), run),
                  curve,
-                 PaperMetricsEvalCallback(make_eval_env, run_dir / "eval.csv", int(hp.get("eval_freq", 0)))]
+                 PaperMetricsEvalCallback(make_eval_env, run.eval_file, int(hp.get("eval_freq", 0)))]
     if hp.get("curriculum", True):
         callbacks.insert(0, CurriculumCallback(total, curriculum=teams))
     return callbacks, curve, cpu_time
 
 
-def _save_final(model, vec_env, run_dir: Path, cpu_time) -> None:
+def _save_final(model, vec_env, run: RunFolder, cpu_time) -> None:
     """The last checkpoint (and its reward statistics) whatever ended the run, its CPU time, and
     the env closed."""
-    if isinstance(vec_env, VecNormalize):
-        save_statistics_atomically(vec_env, run_dir / "checkpoints" / VECNORMALIZE_FILE.format(model.num_timesteps))
-    save_atomically(model, run_dir / "checkpoints" / f"model_{model.num_timesteps}_steps.zip")
+    save_checkpoint(model, run)
     cpu_time.record(model.num_timesteps)
     vec_env.close()

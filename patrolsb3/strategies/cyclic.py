@@ -17,7 +17,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.maps import STAY, MapSpec
-from ..core.state import ACTIVE
 from .base import HeuristicPolicy
 from .navigation import patrol_distances
 

@@ -1,0 +1,115 @@
+"""patrolsb3.runs: the run folder's one owner (paths, checkpoints, config, atomic CSV blocks,
+the cut back on resume)."""
+import csv
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from patrolsb3.runs import ConfigError, RunFolder, append_csv_rows, write_atomically
+
+
+def test_paths_and_names_of_a_run_folder(tmp_path):
+    run = RunFolder(tmp_path / "run")
+    assert run.checkpoint_file(400) == tmp_path / "run" / "checkpoints" / "model_400_steps.zip"
+    assert run.statistics_file(400).name == "model_vecnormalize_400_steps.pkl"
+    assert RunFolder.of_model(run.checkpoint_file(400)) == run
+    assert RunFolder.of_model(run.model_file) == run
+    assert not run.has_files()
+    run.create()
+    assert run.checkpoints_dir.is_dir() and run.has_files()
+
+
+def test_checkpoints_sort_by_steps_and_the_newest_valid_one_is_taken(tmp_path):
+    import zipfile
+    run = RunFolder(tmp_path)
+    run.create()
+    for steps in (800, 400, 1200):
+        with zipfile.ZipFile(run.checkpoint_file(steps), "w") as archive:
+            archive.writestr("data", "{}")
+    run.checkpoint_file(1600).write_bytes(b"")                      # a write cut by a kill
+    assert [p.name for p in run.checkpoints()] == [f"model_{s}_steps.zip" for s in (400, 800, 1200, 1600)]
+    skipped = []
+    assert run.newest_checkpoint(skipped) == run.checkpoint_file(1200)
+    assert skipped == [run.checkpoint_file(1600)]
+    assert run.newest_model() == run.checkpoint_file(1200)          # no model.zip: a stopped run
+
+
+def test_config_is_written_and_read_through_the_schema(tmp_path):
+    run = RunFolder(tmp_path)
+    run.write_config({"map": "A", "seed": 3})
+    assert run.read_config() == {"map": "A", "seed": 3}
+    with pytest.raises(ConfigError, match="settings this code does not know: \\['colour'\\]"):
+        run.write_config({"map": "A", "colour": "red"})
+    run.config_file.write_text("map: [A\n")
+    with pytest.raises(ConfigError, match="config.yml: not valid YAML"):
+        run.read_config()
+    assert RunFolder(tmp_path / "none").read_config() == {}
+
+
+def test_command_lines_are_appended(tmp_path):
+    run = RunFolder(tmp_path)
+    run.record_command("patrolsb3 train --map A")
+    run.record_command("patrolsb3 train --map A --resume\n")
+    assert run.command_file.read_text() == "patrolsb3 train --map A\npatrolsb3 train --map A --resume\n"
+
+
+def test_csv_blocks_are_appended_whole_and_cut_back_on_resume(tmp_path):
+    run = RunFolder(tmp_path)
+    fields = ("timesteps", "reward")
+    append_csv_rows(run.curve_file, fields, [])                   # the header alone
+    assert run.curve_file.read_text().splitlines() == ["timesteps,reward"]
+    append_csv_rows(run.curve_file, fields, [{"timesteps": 400, "reward": 1.0}, {"timesteps": 800, "reward": 2.0}])
+    append_csv_rows(run.curve_file, fields, [{"timesteps": 1200, "reward": 3.0, "extra": "left out"}])
+    append_csv_rows(run.eval_file, fields, [{"timesteps": 800, "reward": 5.0}, {"timesteps": 1600, "reward": 6.0}])
+    with run.curve_file.open("a") as f:
+        f.write("16")                                              # a line cut by a kill (an old run)
+    run.cut_back_to(800)
+    with run.curve_file.open() as f:
+        assert [r["timesteps"] for r in csv.DictReader(f)] == ["400", "800"]
+    with run.eval_file.open() as f:
+        assert [r["timesteps"] for r in csv.DictReader(f)] == ["800"]
+    assert not (tmp_path / ".partial").exists()
+
+
+def test_a_kill_during_a_block_append_leaves_the_file_whole(tmp_path):
+    """SIGKILL while a big block is being appended: the file holds every old row and either the
+    whole block or none of it (the block is written beside it and renamed)."""
+    path = tmp_path / "curve.csv"
+    append_csv_rows(path, ("timesteps", "x"), [{"timesteps": i, "x": 0} for i in range(10)])
+    script = textwrap.dedent(f"""
+        import os, signal
+        from patrolsb3 import runs
+        real = runs.write_atomically
+        def killed_midway(path, write):
+            def partial_then_kill(partial):
+                write(partial)
+                os.kill(os.getpid(), signal.SIGKILL)     # the block is written, not yet renamed
+            return real(path, partial_then_kill)
+        runs.write_atomically = killed_midway
+        runs.append_csv_rows({str(path)!r}, ("timesteps", "x"), [{{"timesteps": i, "x": 1}} for i in range(10, 5000)])
+    """)
+    proc = subprocess.run([sys.executable, "-c", script])
+    assert proc.returncode == -signal.SIGKILL
+    with path.open() as f:
+        rows = list(csv.DictReader(f))
+    assert [int(r["timesteps"]) for r in rows] == list(range(10))
+    append_csv_rows(path, ("timesteps", "x"), [{"timesteps": 10, "x": 1}])   # the next write goes through
+    with path.open() as f:
+        assert len(list(csv.DictReader(f))) == 11
+
+
+def test_write_atomically_leaves_the_old_file_when_the_writer_fails(tmp_path):
+    path = tmp_path / "config.yml"
+    path.write_text("old\n")
+
+    def broken(partial):
+        partial.write_text("half")
+        raise OSError("disk full")
+    with pytest.raises(OSError):
+        write_atomically(path, broken)
+    assert path.read_text() == "old\n"
+    assert os.listdir(tmp_path) in (["config.yml"], sorted(["config.yml", ".partial"]), [".partial", "config.yml"])
