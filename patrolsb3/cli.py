@@ -1,5 +1,5 @@
 """The ``patrolsb3`` command line: ``patrolsb3 maps | render | evaluate | compare | train |
-bench | zoo``.
+bench | zoo | sweep``.
 
 Each sub-command lives in its own module ``patrolsb3.commands.<name>`` with two functions,
 ``add_arguments(parser)`` and ``run(args) -> int``; modules import their heavy dependencies
@@ -19,6 +19,7 @@ COMMANDS = {
     "train": "train a parameter-shared policy with SB3",
     "bench": "measure speed: env | evaluate | train",
     "zoo": "list or inspect the trained checkpoints in zoo/",
+    "sweep": "a grid of training runs as Ray Tune trials (the ray extra), resumable",
 }
 
 

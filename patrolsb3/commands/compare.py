@@ -32,6 +32,21 @@ def zoo_note(zoo, map_name: str, strategy: str, reused: bool) -> str:
     return f"{setting}; figures {'reused from its eval.json' if reused else 'computed now'}"
 
 
+def timed(function, **kwargs):
+    """``(function(**kwargs), seconds it took)``."""
+    import time
+    begun = time.time()
+    return function(**kwargs), time.time() - begun
+
+
+def report_cell(r: dict, name: str, n: int, source: str) -> None:
+    """The progress line of one cell: its figures and where they came from (or its time)."""
+    from ..report import clean_figures
+    s = r["summary"]
+    print(f"map {r['map']} {name:>16} n={n}: {clean_figures(s)} "
+          f"BF {s['battery_failure_rate']['mean']:.3f} BLv {s['swap_battery_pct']['mean']:.1f}{source}", flush=True)
+
+
 def add_arguments(parser):
     parser.add_argument("--maps", default="A,B,C,D", help="comma-separated maps (default A,B,C,D)")
     parser.add_argument("--agents", default="1-5", help="team sizes, e.g. 1-5 or 1,3,5 (default 1-5)")
@@ -53,6 +68,12 @@ def add_arguments(parser):
                              "a result of this exact protocol (a rerun or an interrupted run reuses them)")
     parser.add_argument("--device", default="cpu", choices=["auto", "cpu", "cuda"],
                         help="where zoo models' networks run (default cpu; auto = cuda when torch sees one)")
+    parser.add_argument("--ray", action="store_true",
+                        help="evaluate the cells (map, strategy, team size) as Ray tasks, one CPU each "
+                             "(needs the ray extra: pip install -e \".[ray]\"); same results.json, same figures")
+    parser.add_argument("--address", default=None,
+                        help="with --ray: the Ray cluster to join (HOST:6379, or auto); default: start Ray "
+                             "on this machine with its cores")
     parser.add_argument("--rerun-zoo", action="store_true",
                         help="evaluate zoo models again even when their eval.json already holds this "
                              "exact protocol (episodes, steps, seed, tests, action mode)")
@@ -62,7 +83,7 @@ def run(args):
     import importlib
 
     from ..evaluate import evaluate, evaluation_setup, request_of
-    from ..report import EXTRA_COLUMNS, ZOO_COLUMNS, clean_figures, write_compare
+    from ..report import EXTRA_COLUMNS, ZOO_COLUMNS, write_compare
     from ..result_store import ResultStore
     from ..sb3.algorithms import torch_device
     torch_device(args.device)   # a device torch cannot use: one line, before any work
@@ -91,9 +112,13 @@ def run(args):
             missing = [m for m in maps if zoo is None or not zoo.available(m, name.split(":", 1)[1])]
             if missing:
                 raise ValueError(f"{name}: no zoo model for map(s) {', '.join(missing)}")
+    if args.address and not args.ray:
+        raise ValueError("--address joins a Ray cluster: give it with --ray")
+    if args.ray:
+        from ..distributed import require_ray
+        require_ray()                # not installed: one line saying how, before any work
     store = ResultStore(args.out)
-    results = []
-    zoo_notes = {}
+    cells = []                       # (map, strategy, team size) in report order
     for m in maps:
         if args.strategies:
             names = [canonical_name(s) for s in args.strategies.split(",") if s.strip()]
@@ -101,31 +126,41 @@ def run(args):
             names = ["CR", "PART", "SEBS", *EXTRA_COLUMNS]
             if zoo is not None:
                 names += [s for s in ZOO_COLUMNS.values() if zoo.available(m, s.split(":", 1)[1])]
-        for name in names:
-            for n in sizes:
-                r = None
-                if zoo is not None and name.startswith("zoo:") and not args.rerun_zoo:
-                    r = zoo.cached_result(m, name.split(":", 1)[1], n, args.episodes, args.steps,
-                                          args.seed, args.tests, deterministic=not args.stochastic)
-                source = "  (from the zoo's eval.json; --rerun-zoo to run it)" if r else ""
-                if r is None and not args.rerun and not name.startswith("zoo:"):
-                    spec, cfg = evaluation_setup(m, n, args.episodes, args.tests, args.steps)
-                    r = store.find(request_of(name, spec, n, args.episodes, args.tests, args.steps,
-                                              args.seed, cfg, deterministic=not args.stochastic))
-                    source = f"  (from {store.path}; --rerun to run it)" if r else ""
-                if r is None:
-                    r = evaluate(name, m, n, episodes=args.episodes, tests=args.tests, steps=args.steps,
-                                 seed=args.seed, progress=not args.no_progress,
-                                 deterministic=not args.stochastic, device=args.device)
-                    if not name.startswith("zoo:"):
-                        store.add(r)
-                s = r["summary"]
-                print(f"map {r['map']} {name:>16} n={n}: {clean_figures(s)} "
-                      f"BF {s['battery_failure_rate']['mean']:.3f} BLv {s['swap_battery_pct']['mean']:.1f}{source}",
-                      flush=True)
-                results.append(r)
-                if name.startswith("zoo:"):
-                    zoo_notes[(m.upper(), name)] = zoo_note(zoo, m, name, reused=bool(source))
+        cells += [(m, name, n) for name in names for n in sizes]
+    found, sources = {}, {}
+    for m, name, n in cells:         # what a zoo entry's eval.json or results.json already holds
+        r = None
+        if zoo is not None and name.startswith("zoo:") and not args.rerun_zoo:
+            r = zoo.cached_result(m, name.split(":", 1)[1], n, args.episodes, args.steps,
+                                  args.seed, args.tests, deterministic=not args.stochastic)
+            sources[(m, name, n)] = "  (from the zoo's eval.json; --rerun-zoo to run it)" if r else ""
+        if r is None and not args.rerun and not name.startswith("zoo:"):
+            spec, cfg = evaluation_setup(m, n, args.episodes, args.tests, args.steps)
+            r = store.find(request_of(name, spec, n, args.episodes, args.tests, args.steps,
+                                      args.seed, cfg, deterministic=not args.stochastic))
+            sources[(m, name, n)] = f"  (from {store.path}; --rerun to run it)" if r else ""
+        if r is not None:
+            found[(m, name, n)] = r
+            report_cell(r, name, n, sources[(m, name, n)])
+    missing = [c for c in cells if c not in found]
+    jobs = [dict(strategy=name, map_name=m, n_agents=n, episodes=args.episodes, tests=args.tests,
+                 steps=args.steps, seed=args.seed, deterministic=not args.stochastic, device=args.device)
+            for m, name, n in missing]
+    if args.ray:
+        from ..distributed import connect, evaluate_on_ray
+        cpus = connect(args.address).get("CPU", 0)
+        print(f"ray: {len(jobs)} cells on {cpus:.0f} CPUs", flush=True)
+        finished = ((missing[i], r, seconds) for i, r, seconds in evaluate_on_ray(jobs))
+    else:
+        finished = ((cell, *timed(evaluate, progress=not args.no_progress, **job)) for cell, job in zip(missing, jobs))
+    for (m, name, n), r, seconds in finished:   # each stored as soon as it is done
+        if not name.startswith("zoo:"):
+            store.add(r)
+        found[(m, name, n)] = r
+        report_cell(r, name, n, f"  ({seconds:.1f} s)")
+    results = [found[c] for c in cells]
+    zoo_notes = {(m.upper(), name): zoo_note(zoo, m, name, reused=bool(sources.get((m, name, n))))
+                 for m, name, n in cells if name.startswith("zoo:")}
     curves = {}
     if zoo is not None:
         for m in maps:

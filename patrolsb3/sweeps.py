@@ -1,0 +1,262 @@
+"""Training sweeps: a grid of runs read from a YAML file, each trial a normal run folder.
+
+A sweep file (``patrolsb3 sweep SWEEP.yml``)::
+
+    out: runs/sweep-a            # root of the run folders (--out overrides)
+    timesteps: 400000            # agent-steps of every trial
+    recipe: zoo-stage1           # optional: named overrides (patrolsb3/sb3/recipes.py)
+    set:                         # optional: --set keys applied to every trial
+      n_envs: 8
+    grid:                        # the product of these lists is the set of trials
+      map: [A, C]
+      variant: [rl-msg, rl-no-msg]
+      seed: [0, 1, 2]
+      set:                       # optional: any --set key, each with a list of values
+        learning_rate: [3.0e-4, 1.0e-4]
+
+Each trial trains with :func:`patrolsb3.sb3.train.train` into
+``<out>/<map>/<variant>/seed<seed>[_<key>=<value>...]`` (the layout of ``patrolsb3 train --out
+OUT --run-id ID``), so its folder holds what a train run holds and every tool that reads run
+folders reads it. The folders are the sweep's state: a trial whose ``model.zip`` has its
+agent-steps is finished and skipped, one with a checkpoint resumes from it (``--resume``), any
+other starts afresh. Running the same sweep again therefore finishes what is left and starts
+nothing when all is done. Ray (``patrolsb3.distributed``) only spreads the trials over CPUs
+and machines.
+"""
+from __future__ import annotations
+
+import itertools
+import shutil
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+SWEEP_KEYS = {"out", "timesteps", "recipe", "set", "grid"}
+GRID_KEYS = {"map", "variant", "seed", "set"}
+
+
+class SweepError(ValueError):
+    """A sweep file that cannot be read (names the file and the problem)."""
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One run of a sweep.
+
+    Attributes:
+        map, variant, seed: what ``patrolsb3 train`` takes as --map, --variant, --seed.
+        timesteps: total agent-steps.
+        overrides: hyperparameter overrides (recipe, then the sweep's ``set``, then the grid's).
+        varied: the grid's ``set`` values of this trial, {dotted key: value} (in its name).
+        run_dir: its run folder.
+    """
+    map: str
+    variant: str
+    seed: int
+    timesteps: int
+    overrides: dict
+    varied: dict
+    run_dir: Path
+
+    @property
+    def name(self) -> str:
+        """``<map>/<variant>/<run_id>``: how the summary and the progress lines name it."""
+        return f"{self.run_dir.parent.parent.name}/{self.variant}/{self.run_dir.name}"
+
+
+@dataclass
+class TrialOutcome:
+    """How a trial ended: ``status`` is finished, skipped (finished before), error or pending."""
+    trial: Trial
+    status: str
+    seconds: float = 0.0
+    error: str = ""
+    figures: dict = field(default_factory=dict)
+
+
+def run_id(seed: int, varied: dict) -> str:
+    """``seed<seed>`` and the varied settings, e.g. ``seed0_learning_rate=0.0003``."""
+    parts = [f"seed{seed}"] + [f"{k}={_plain(v)}" for k, v in varied.items()]
+    return "_".join(parts).replace("/", "-").replace(" ", "")
+
+
+def _plain(value) -> str:
+    return yaml.safe_dump(value, default_flow_style=True).strip().removesuffix("...").strip()
+
+
+def _dotted(node: dict, prefix: str = "") -> dict:
+    """``{"env": {"c_home": [0, 50]}}`` -> ``{"env.c_home": [0, 50]}``."""
+    out = {}
+    for key, value in node.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out.update(_dotted(value, name + "."))
+        else:
+            out[name] = value
+    return out
+
+
+def _nested(dotted: dict) -> dict:
+    out: dict = {}
+    for key, value in dotted.items():
+        parts = key.split(".")
+        node = out
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+        node[parts[-1]] = value
+    return out
+
+
+def _map_folder(map_name: str) -> str:
+    """The folder name ``train`` uses for a map (its name: ``A``, or a map file's stem); a map
+    that cannot be loaded keeps its text (:func:`check_trial` reports why)."""
+    from .core.maps import MapError, load_map
+    try:
+        return load_map(map_name).name
+    except (MapError, ValueError, OSError):
+        return Path(map_name).name.replace(" ", "_")
+
+
+def read_sweep(path, out=None) -> list[Trial]:
+    """The trials of a sweep file, in grid order.
+
+    Args:
+        path: the YAML sweep file (module docstring).
+        out: the root of the run folders (default: the file's ``out``).
+
+    Raises:
+        SweepError: not YAML, an unknown key, a grid value that is not a non-empty list, no
+            ``timesteps`` or no ``out`` (one line naming the file and the key).
+    """
+    from .sb3.hyperparams import merge
+    from .sb3.recipes import recipe
+    path = Path(path)
+    try:
+        spec = yaml.safe_load(path.read_text())
+    except FileNotFoundError:
+        raise SweepError(f"{path}: no such sweep file") from None
+    except (yaml.YAMLError, UnicodeDecodeError) as exc:
+        raise SweepError(f"{path}: not valid YAML ({str(exc).splitlines()[0]})") from None
+    if not isinstance(spec, dict):
+        raise SweepError(f"{path}: expected a mapping with grid, timesteps and out")
+    if unknown := sorted(set(spec) - SWEEP_KEYS):
+        raise SweepError(f"{path}: unknown key(s) {unknown}; known: {sorted(SWEEP_KEYS)}")
+    grid = spec.get("grid")
+    if not isinstance(grid, dict) or not grid:
+        raise SweepError(f"{path}: 'grid' must be a mapping of lists (map, variant, seed, set)")
+    if unknown := sorted(set(grid) - GRID_KEYS):
+        raise SweepError(f"{path}: unknown grid key(s) {unknown}; known: {sorted(GRID_KEYS)}")
+    timesteps = spec.get("timesteps")
+    if isinstance(timesteps, bool) or not isinstance(timesteps, int) or timesteps < 1:
+        raise SweepError(f"{path}: 'timesteps' must be a whole number of agent-steps >= 1, got {timesteps!r}")
+    root = out if out is not None else spec.get("out")
+    if not root:
+        raise SweepError(f"{path}: no 'out' folder (give it in the file or with --out)")
+    fixed = spec.get("set") or {}
+    grid_set = grid.get("set") or {}
+    if not isinstance(fixed, dict) or not isinstance(grid_set, dict):
+        raise SweepError(f"{path}: 'set' must be a mapping of hyperparameters")
+    axes = {"map": grid.get("map", ["A"]), "variant": grid.get("variant", ["rl-msg"]),
+            "seed": grid.get("seed", [0]), **_dotted(grid_set)}
+    for key, values in axes.items():
+        if not isinstance(values, list) or not values:
+            raise SweepError(f"{path}: grid value of {key!r} must be a non-empty list, got {values!r}")
+    for seed in axes["seed"]:
+        if isinstance(seed, bool) or not isinstance(seed, int):
+            raise SweepError(f"{path}: grid seeds must be whole numbers, got {seed!r}")
+    base = recipe(spec["recipe"]) if spec.get("recipe") else {}
+    base = merge(base, fixed)
+    trials = []
+    for combo in itertools.product(*axes.values()):
+        values = dict(zip(axes, combo))
+        varied = {k: values[k] for k in axes if k not in ("map", "variant", "seed")}
+        map_name, variant, seed = str(values["map"]), str(values["variant"]), int(values["seed"])
+        trials.append(Trial(map=map_name, variant=variant, seed=seed, timesteps=int(timesteps),
+                            overrides=merge(base, _nested(varied)), varied=varied,
+                            run_dir=Path(root) / _map_folder(map_name) / variant / run_id(seed, varied)))
+    names = [t.run_dir for t in trials]
+    if len(set(names)) != len(names):
+        raise SweepError(f"{path}: two trials share a run folder (repeated grid values?)")
+    return trials
+
+
+def check_trial(trial: Trial) -> str:
+    """'' when every setting of the trial is valid, else the one-line reason (what ``train``
+    would refuse before any work), so a bad trial fails alone before the sweep starts."""
+    from .core.maps import MapError
+    from .sb3.hyperparams import merge
+    from .sb3.train import resolve_settings
+    try:
+        resolve_settings(trial.map, trial.variant, merge(trial.overrides, {"timesteps": trial.timesteps}))
+    except (ValueError, TypeError, MapError, FileNotFoundError) as exc:
+        return str(exc)
+    return ""
+
+
+def trial_state(trial: Trial) -> str:
+    """finished (model.zip at its agent-steps), resumable (a valid checkpoint) or new."""
+    from .runs import RunFolder, model_steps
+    run = RunFolder(trial.run_dir)
+    if run.model_file.is_file() and (model_steps(run.model_file) or 0) >= trial.timesteps:
+        return "finished"
+    return "resumable" if run.newest_checkpoint() is not None else "new"
+
+
+def run_trial(trial: Trial, torch_threads: int = 1) -> dict:
+    """Train one trial to its agent-steps (resuming its folder when it has a checkpoint; a
+    folder without one, left by a run killed at its start, is started afresh).
+
+    Returns:
+        {"timesteps": agent-steps reached, "seconds": wall time of this call}.
+    """
+    from .runs import RunFolder, model_steps
+    from .sb3.hyperparams import merge
+    from .sb3.train import train
+    started = time.time()
+    state = trial_state(trial)
+    if state == "new" and trial.run_dir.exists():
+        shutil.rmtree(trial.run_dir)
+    if state != "finished":
+        hyperparams = merge({"torch_threads": int(torch_threads)}, trial.overrides)
+        train(map=trial.map, variant=trial.variant, timesteps=trial.timesteps, seed=trial.seed,
+              run_dir=trial.run_dir, resume=state == "resumable", hyperparams=hyperparams,
+              progress_bar=False, device="cpu",
+              command=f"patrolsb3 sweep (trial {trial.name}, {trial.timesteps} agent-steps)")
+    return {"timesteps": model_steps(RunFolder(trial.run_dir).model_file) or 0,
+            "seconds": round(time.time() - started, 1)}
+
+
+def last_figures(trial: Trial, episodes: int = 20) -> dict:
+    """The mean of the last ``episodes`` rows of the trial's curve.csv: reward, mean and max
+    idleness, battery failures ({} without a curve)."""
+    import csv
+
+    from .runs import RunFolder
+    path = RunFolder(trial.run_dir).curve_file
+    if not path.is_file():
+        return {}
+    with path.open(newline="") as f:
+        rows = list(csv.DictReader(f))[-episodes:]
+    if not rows:
+        return {}
+    keys = ("reward", "mean_idleness", "max_idleness", "battery_failures")
+    return {k: sum(float(r[k]) for r in rows) / len(rows) for k in keys}
+
+
+def summary_table(outcomes: list[TrialOutcome]) -> str:
+    """A markdown table: trial, status, final agent-steps, last curve figures, time, error."""
+    from .runs import RunFolder, model_steps
+    lines = ["| trial | status | agent-steps | reward | mean idleness | max idleness | battery failures "
+             "| seconds | error |", "|---|---|---|---|---|---|---|---|---|"]
+    for o in outcomes:
+        run = RunFolder(o.trial.run_dir)
+        model = run.newest_model()
+        steps = (model_steps(model) or 0) if model is not None else 0
+        f = o.figures or last_figures(o.trial)
+        cells = [f"{f[k]:.1f}" if k in f else "" for k in ("reward", "mean_idleness", "max_idleness")]
+        cells.append(f"{f['battery_failures']:.2f}" if "battery_failures" in f else "")
+        lines.append(f"| {o.trial.name} | {o.status} | {steps:,} | {' | '.join(cells)} | {o.seconds:.0f} "
+                     f"| {o.error.splitlines()[0][:200] if o.error else ''} |")
+    return "\n".join(lines)
