@@ -1,5 +1,5 @@
 """The ``patrolsb3`` command line: ``patrolsb3 maps | render | evaluate | compare | train |
-bench | zoo | sweep``.
+bench | zoo | sweep | claims``.
 
 Each sub-command lives in its own module ``patrolsb3.commands.<name>`` with two functions,
 ``add_arguments(parser)`` and ``run(args) -> int``; modules import their heavy dependencies
@@ -20,6 +20,7 @@ COMMANDS = {
     "bench": "measure speed: env | evaluate | train",
     "zoo": "list or inspect the trained checkpoints in zoo/",
     "sweep": "a grid of training runs as Ray Tune trials (the ray extra), resumable",
+    "claims": "the paper's claims, one row each, tested on a comparison's figures",
 }
 
 

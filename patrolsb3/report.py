@@ -5,7 +5,8 @@
   ``-MAX.csv``, ``-MEAN.csv``, ``-COLLISION.csv`` with columns ``n,CR,PART,SEBS,INTENTION,
   NOMSG,MSG`` (cells are means over tests; a strategy that was not run is an empty cell),
   the same tables for the extra strategies in ``<MAP>-<TABLE>-extra.csv`` (columns
-  ``n,RANDOM,CYCLIC``), every figure with its std in ``results.csv`` (long format), one
+  ``n,RANDOM,CYCLIC``), every figure with its std over tests and its 95 % interval over
+  episodes in ``results.csv`` (long format), one
   ``report.md`` with all tables as mean +- std, and one PNG per map (idleness per team size,
   collisions, battery).
 """
@@ -192,16 +193,23 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
     long_path = out / "results.csv"
     with long_path.open("w", newline="") as fh:
         writer = csv.writer(fh)
-        writer.writerow(["map", "n", "strategy", "metric", "mean", "std", "clean_episodes",
-                         "episodes", "tests", "steps", "deterministic"])
+        writer.writerow(["map", "n", "strategy", "metric", "mean", "std", "ci95_low", "ci95_high",
+                         "clean_episodes", "episodes", "tests", "steps", "deterministic"])
         for r in results:
             metrics = [m for m, v in r["summary"].items() if isinstance(v, dict) and "mean" in v]
             for metric in metrics:                 # LABELS' metrics and their *_all twins
                 s = r["summary"][metric]
-                writer.writerow([r["map"], r["n_agents"], r["strategy"], metric, s["mean"], s["std"],
+                low, high = s.get("ci95") or ("", "")   # results stored before the intervals have none
+                writer.writerow([r["map"], r["n_agents"], r["strategy"], metric, s["mean"], s["std"], low, high,
                                  sum(r["summary"]["clean_episodes"]), r["episodes"] * r["tests"],
                                  r["tests"], r["steps"], r.get("deterministic", True)])
     written.append(long_path)
+    if any(str(r.get("strategy", "")).startswith("zoo:") for r in results):   # the claims head the report
+        from .claims import claims, claims_table, read_figures
+        rows = claims(read_figures(long_path), curves=learning_curves)
+        md[2:2] = ["## The paper's claims on these figures", "",
+                   "One row per claim (`patrolsb3 claims`, which says how each verdict is reached).", "",
+                   claims_table(rows), ""]
     report = out / "report.md"
     report.write_text("\n".join(md) + "\n")
     written.append(report)

@@ -182,3 +182,38 @@ def test_a_zoo_model_zip_loads_as_an_sb3_model_and_acts_on_the_training_env():
     trainable = MaskableRecurrentPPO.load(entry, env=venv, device="cpu", n_steps=8, batch_size=32)
     trainable.learn(8 * venv.num_envs)
     assert trainable.num_timesteps == 8 * venv.num_envs
+
+
+def test_the_message_head_can_have_an_entropy_coefficient_of_its_own():
+    """With ent_coef_message, the move head's entropy is averaged over every real row (weighted by
+    ent_coef) and the message head's over the rows where it has a choice (weighted by
+    ent_coef_message); with both at 0 the loss is the plain PPO loss without entropy."""
+    model, _ = tiny_model(agents=(2, 3, 3))
+    buffer = collect(model)
+    data = next(buffer.get(None))
+    mask = data.mask > 1e-8
+    with th.no_grad():
+        _, _, per_head = model.policy.evaluate_actions(data.observations, data.actions, data.lstm_states,
+                                                       data.episode_starts, action_masks=data.action_masks,
+                                                       per_head=True)
+    n_messages = int(model.action_space.nvec[0])
+    speaking = mask & (data.action_masks[:, :n_messages].sum(dim=1) > 1)
+    assert 0 < int(speaking.sum()) < int(mask.sum())           # message phases only: some rows, not all
+    model.ent_coef, model.ent_coef_message = 0.0, 0.3
+    loss, terms = model.minibatch_loss(data, clip_range=0.15)
+    assert terms["message_entropy_loss"] == pytest.approx(-per_head[:, 0][speaking].mean().item(), rel=1e-5)
+    assert terms["entropy_loss"] == pytest.approx(-per_head[:, 1][mask].mean().item(), rel=1e-5)
+    assert terms["message_entropy_loss"] < 0                   # a real bonus: the head has a choice
+    plain = loss.item() - 0.3 * terms["message_entropy_loss"]
+    model.ent_coef_message = None                              # the default: one coefficient, 0 here
+    default_loss, _ = model.minibatch_loss(data, clip_range=0.15)
+    assert plain == pytest.approx(default_loss.item(), rel=1e-5)
+
+
+def test_ent_coef_message_is_refused_where_it_means_nothing():
+    with pytest.raises(ValueError, match="ent_coef_message must be a number"):
+        MaskableRecurrentPPO(PatrolRecurrentPolicy, tiny_model()[1], ent_coef_message="high")
+    from patrolsb3.sb3.train import check_run_settings, resolve_hyperparams
+    hp = resolve_hyperparams("A", overrides={"algo": "MaskablePPO", "ent_coef_message": 0.01})
+    with pytest.raises(ValueError, match="ent_coef_message is a setting of MaskableRecurrentPPO"):
+        check_run_settings(hp, 1000)

@@ -1,7 +1,9 @@
 """``patrolsb3 zoo list``: every zoo entry with its budget, date, env version and headline
 figures; ``patrolsb3 zoo show MAP VARIANT``: one entry's config and evaluation; ``patrolsb3 zoo
 export RUN``: a run into the zoo; ``patrolsb3 zoo validate RUN``: rank a run's checkpoints;
-``patrolsb3 zoo listening MAP VARIANT``: what its messages carry (:mod:`patrolsb3.listening`)."""
+``patrolsb3 zoo listening MAP VARIANT``: what its messages carry (:mod:`patrolsb3.listening`);
+``patrolsb3 zoo ablation MAP VARIANT``: what the team loses when it cannot trust them
+(:mod:`patrolsb3.ablation`)."""
 import json
 import math
 
@@ -60,6 +62,18 @@ def add_arguments(parser):
     p_lis.add_argument("--episodes", type=int, default=8, help="parallel episodes (default 8)")
     p_lis.add_argument("--steps", type=int, default=500, help="simulator steps (default 500)")
     p_lis.add_argument("--seed", type=int, default=1000, help="seed (default 1000; the zoo's eval uses 0)")
+    p_abl = sub.add_parser("ablation", help="the entry's AVG^h, MAX^h and collisions when the messages it "
+                                            "receives are made constant or shuffled between agents")
+    p_abl.add_argument("map")
+    p_abl.add_argument("variant", help="rl-msg or rl-intention")
+    p_abl.add_argument("--zoo-dir", default=None)
+    p_abl.add_argument("--seed-of-entry", type=int, default=None, dest="entry_seed",
+                       help="one training seed's model (default: the entry's)")
+    p_abl.add_argument("--agents", type=int, default=3, help="team size (default 3)")
+    p_abl.add_argument("--episodes", type=int, default=10, help="episodes (default 10)")
+    p_abl.add_argument("--steps", type=int, default=2000, help="simulator steps per episode (default 2000)")
+    p_abl.add_argument("--seed", type=int, default=1000, help="seed (default 1000; the zoo's eval uses 0)")
+    p_abl.add_argument("--json", default=None, metavar="FILE", help="also write the figures as JSON")
 
 
 def relative_path(path) -> str:
@@ -111,6 +125,22 @@ def run(args):
         figures = listening(load(args.map, args.variant, zoo_dir=args.zoo_dir), n_agents=args.agents,
                             episodes=args.episodes, steps=args.steps, seed=args.seed)
         print(json.dumps({"entry": f"{args.map.upper()}/{args.variant}", **figures}))
+        return 0
+    if args.zoo_command == "ablation":
+        from ..ablation import ablation_table, message_ablation
+        from ..outputs import check_output_file, write_json
+        from ..zoo import load
+        if args.json:
+            check_output_file(args.json, "--json")
+        for name in ("agents", "episodes", "steps"):
+            if getattr(args, name) < 1:
+                raise ValueError(f"--{name} must be >= 1, got {getattr(args, name)}")
+        policy = load(args.map, args.variant, zoo_dir=args.zoo_dir, seed=args.entry_seed)
+        figures = message_ablation(policy, n_agents=args.agents, episodes=args.episodes, steps=args.steps,
+                                   seed=args.seed)
+        print(ablation_table(f"{args.map.upper()}/{args.variant}", figures))
+        if args.json:
+            write_json(args.json, {"entry": f"{args.map.upper()}/{args.variant}", **figures}, indent=2)
         return 0
     if args.zoo_command == "show":
         entry = read_entry(entry_dir(args.map, args.variant, args.zoo_dir))

@@ -68,13 +68,25 @@ class MaskableRecurrentPPO(RecurrentPPO):
 
     policy_aliases: ClassVar[dict] = {"PatrolRecurrentPolicy": PatrolRecurrentPolicy}
 
-    def __init__(self, *args, n_minibatches: int | None = None, **kwargs):
-        """Args as :class:`sb3_contrib.RecurrentPPO`, plus ``n_minibatches``: when given, each
-        update splits the rollout's deployed rows into that many minibatches (``batch_size``
-        is then ignored)."""
+    def __init__(self, *args, n_minibatches: int | None = None, ent_coef_message: float | None = None, **kwargs):
+        """Args as :class:`sb3_contrib.RecurrentPPO`, plus
+
+        Args:
+            n_minibatches: when given, each update splits the rollout's deployed rows into that
+                many minibatches (``batch_size`` is then ignored).
+            ent_coef_message: an entropy coefficient of the message head of its own (OURS, for
+                learned messages): its entropy bonus is averaged over the rows whose message
+                head has a choice (the message phases of rl-msg), not diluted over every row,
+                and ``ent_coef`` then weighs the move head's entropy alone. None (default): one
+                ``ent_coef`` on the summed entropy of both heads over every row, as SB3.
+        """
         if n_minibatches is not None and int(n_minibatches) < 1:
             raise ValueError(f"n_minibatches must be >= 1, got {n_minibatches}")
+        if ent_coef_message is not None and (isinstance(ent_coef_message, bool) or
+                                             not isinstance(ent_coef_message, (int, float))):
+            raise ValueError(f"ent_coef_message must be a number or None, got {ent_coef_message!r}")
         self.n_minibatches = None if n_minibatches is None else int(n_minibatches)
+        self.ent_coef_message = None if ent_coef_message is None else float(ent_coef_message)
         super().__init__(*args, **kwargs)
 
     def update_batch_size(self) -> int:
@@ -193,6 +205,7 @@ class MaskableRecurrentPPO(RecurrentPPO):
         clip_range = self.clip_range(self._current_progress_remaining)
         clip_range_vf = self.clip_range_vf(self._current_progress_remaining) if self.clip_range_vf is not None else None
         entropy_losses, pg_losses, value_losses, clip_fractions, approx_kl_divs = [], [], [], [], []
+        message_entropy_losses = []
         continue_training = True
         for epoch in range(self.n_epochs):
             approx_kl_divs = []
@@ -202,6 +215,8 @@ class MaskableRecurrentPPO(RecurrentPPO):
                 clip_fractions.append(terms["clip_fraction"])
                 value_losses.append(terms["value_loss"])
                 entropy_losses.append(terms["entropy_loss"])
+                if "message_entropy_loss" in terms:
+                    message_entropy_losses.append(terms["message_entropy_loss"])
                 approx_kl_div = terms["approx_kl"]
                 approx_kl_divs.append(approx_kl_div)
                 if self.target_kl is not None and approx_kl_div > 1.5 * self.target_kl:
@@ -218,6 +233,8 @@ class MaskableRecurrentPPO(RecurrentPPO):
                 break
         explained_var = explained_variance(self.rollout_buffer.values.flatten(), self.rollout_buffer.returns.flatten())
         self.logger.record("train/entropy_loss", np.mean(entropy_losses))
+        if message_entropy_losses:
+            self.logger.record("train/message_entropy_loss", np.mean(message_entropy_losses))
         self.logger.record("train/policy_gradient_loss", np.mean(pg_losses))
         self.logger.record("train/value_loss", np.mean(value_losses))
         self.logger.record("train/approx_kl", np.mean(approx_kl_divs))
@@ -247,9 +264,10 @@ class MaskableRecurrentPPO(RecurrentPPO):
         mask = data.mask > 1e-8                                                    # real (not padded) steps
         if row_mask is not None:
             mask = mask & row_mask
+        message_coef = getattr(self, "ent_coef_message", None)      # absent in older checkpoints
         values, log_prob, entropy = self.policy.evaluate_actions(
             data.observations, data.actions, data.lstm_states, data.episode_starts,
-            action_masks=data.action_masks)
+            action_masks=data.action_masks, per_head=message_coef is not None)
         values = values.flatten()
         advantages = data.advantages
         if self.normalize_advantage and int(mask.sum()) > 1:   # as SB3's PPO: not over a single row
@@ -263,15 +281,26 @@ class MaskableRecurrentPPO(RecurrentPPO):
         else:
             values_pred = data.old_values + th.clamp(values - data.old_values, -clip_range_vf, clip_range_vf)
         value_loss = th.mean(((data.returns - values_pred) ** 2)[mask])
-        entropy_loss = -th.mean(entropy[mask])
-        loss = policy_loss + self.ent_coef * entropy_loss + self.vf_coef * value_loss
+        terms = {}
+        if message_coef is None:
+            entropy_loss = -th.mean(entropy[mask])
+            loss = policy_loss + self.ent_coef * entropy_loss + self.vf_coef * value_loss
+        else:                   # each head its own coefficient; the message head over its choices only
+            n_messages = int(self.action_space.nvec[0])
+            speaking = mask & (data.action_masks[:, :n_messages].sum(dim=1) > 1)   # (n,) message choices
+            entropy_loss = -th.mean(entropy[:, 1][mask])
+            message_entropy_loss = (-th.mean(entropy[:, 0][speaking]) if bool(speaking.any())
+                                    else entropy.new_zeros(()))
+            loss = (policy_loss + self.ent_coef * entropy_loss + message_coef * message_entropy_loss
+                    + self.vf_coef * value_loss)
+            terms["message_entropy_loss"] = message_entropy_loss.item()
         with th.no_grad():
             log_ratio = log_prob - data.old_log_prob
             approx_kl = th.mean(((th.exp(log_ratio) - 1) - log_ratio)[mask]).item()
             clip_fraction = th.mean((th.abs(ratio - 1) > clip_range).float()[mask]).item()
         return loss, {"policy_loss": policy_loss.item(), "value_loss": value_loss.item(),
                       "entropy_loss": entropy_loss.item(), "clip_fraction": clip_fraction,
-                      "approx_kl": approx_kl}
+                      "approx_kl": approx_kl, **terms}
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = False, action_masks=None):
         """Actions and the next LSTM state; ``action_masks`` (n, 21) restricts the choice.

@@ -263,11 +263,14 @@ class PatrolRecurrentPolicy(_RoleExtractorMixin, RecurrentActorCriticPolicy):
         return actions.reshape((-1, *self.action_space.shape)), self.value_net(latent_vf), log_prob, states
 
     def evaluate_actions(self, obs: th.Tensor, actions: th.Tensor, lstm_states: RNNStates,
-                         episode_starts: th.Tensor, action_masks=None):
-        """Values (B, 1), log-probs (B,) and entropies (B,) of the given actions."""
+                         episode_starts: th.Tensor, action_masks=None, per_head: bool = False):
+        """Values (B, 1), log-probs (B,) and entropies (B,) of the given actions; with
+        ``per_head`` the entropies are (B, 2): message head, move head."""
         latent_pi, latent_vf, _ = self._latents(obs, lstm_states, episode_starts)
         distribution = self._masked_distribution(latent_pi, action_masks)
-        return self.value_net(latent_vf), distribution.log_prob(actions), distribution.entropy()
+        entropy = (th.stack([d.entropy() for d in distribution.distributions], dim=1) if per_head
+                   else distribution.entropy())
+        return self.value_net(latent_vf), distribution.log_prob(actions), entropy
 
     def get_distribution(self, obs: th.Tensor, lstm_states, episode_starts: th.Tensor, action_masks=None):
         """The (masked) action distribution and the actor's new LSTM states."""

@@ -1,0 +1,39 @@
+"""``patrolsb3 claims COMPARE_DIR``: the paper's claims, one row each, with our figure, its 95 %
+interval and a verdict, from a comparison's results (``patrolsb3.claims``)."""
+
+
+def add_arguments(parser):
+    parser.add_argument("compare_dir", metavar="COMPARE_DIR", help="a 'patrolsb3 compare' output folder")
+    parser.add_argument("--zoo-dir", default=None, help="the zoo whose training curves to read (default: zoo/)")
+    parser.add_argument("--faults-result", default=None, metavar="FILE",
+                        help="an 'evaluate --faults STEP:K --json' result, for the claim on failing agents")
+    parser.add_argument("--json", default=None, metavar="FILE", help="also write the rows as JSON")
+
+
+def run(args):
+    import json
+    from pathlib import Path
+
+    from .. import zoo
+    from ..claims import claims, claims_table, read_figures
+    from ..outputs import check_output_file, write_json
+    if args.json:
+        check_output_file(args.json, "--json")
+    figures = read_figures(args.compare_dir)
+    faults = None
+    if args.faults_result:
+        path = Path(args.faults_result)
+        try:
+            faults = json.loads(path.read_text())
+            faults["summary"]
+        except FileNotFoundError:
+            raise ValueError(f"--faults-result {path}: no such file") from None
+        except (ValueError, KeyError, TypeError):
+            raise ValueError(f"--faults-result {path}: not an 'evaluate --json' result") from None
+    curves = {m: {v: p for v in zoo.VARIANT_NAMES if (p := zoo.entry_dir(m, v, args.zoo_dir) / "curve.csv").is_file()}
+              for m in sorted({k[0] for k in figures})}
+    rows = claims(figures, curves=curves, faults_result=faults)
+    print(claims_table(rows))
+    if args.json:
+        write_json(args.json, rows, indent=2)
+    return 0
