@@ -228,6 +228,62 @@ def run_trial(trial: Trial, torch_threads: int = 1) -> dict:
             "seconds": round(time.time() - started, 1)}
 
 
+def run_sweep(path, out=None, address: str | None = None, cpus: int | None = None, cpus_per_trial: int = 1,
+              dry_run: bool = False, say=print) -> list[TrialOutcome]:
+    """A sweep from its file to its outcomes (what ``patrolsb3 sweep`` runs).
+
+    Every trial is checked first (a refused one fails alone, before anything starts); finished
+    trials are skipped; the rest run as Ray Tune trials (:func:`patrolsb3.distributed.sweep_on_ray`).
+
+    Args:
+        path: the sweep file (module docstring).
+        out: root of the run folders (default: the file's ``out``).
+        address: a Ray cluster to join; None starts Ray on this machine.
+        cpus: CPUs a local Ray may use (default: all).
+        cpus_per_trial: CPUs (and torch threads) per trial.
+        dry_run: only list the trials and their state.
+        say: receives the progress lines.
+
+    Returns:
+        One :class:`TrialOutcome` per trial, in grid order.
+
+    Raises:
+        SweepError: a sweep file that cannot be read.
+        ValueError: bad CPU counts, an output folder that cannot be written, or Ray missing
+            when trials are to run (one line saying how to install it).
+    """
+    from .outputs import check_output_dir
+    if isinstance(cpus_per_trial, bool) or not isinstance(cpus_per_trial, int) or cpus_per_trial < 1:
+        raise ValueError(f"cpus_per_trial must be a whole number >= 1, got {cpus_per_trial!r}")
+    if cpus is not None and (isinstance(cpus, bool) or not isinstance(cpus, int) or cpus < 1 or address):
+        raise ValueError(f"cpus must be a whole number >= 1, for a local Ray only (not with an address), got {cpus!r}")
+    trials = read_sweep(path, out=out)
+    check_output_dir(trials[0].run_dir.parents[2], "--out")
+    outcomes = {t.name: TrialOutcome(t, "pending") for t in trials}
+    to_run = []
+    for t in trials:
+        problem = check_trial(t)
+        if problem:
+            outcomes[t.name] = TrialOutcome(t, "error", error=problem)
+            say(f"trial {t.name}: refused before it started: {problem}")
+        elif trial_state(t) == "finished":
+            outcomes[t.name] = TrialOutcome(t, "skipped")
+        else:
+            to_run.append(t)
+    skipped = sum(o.status == "skipped" for o in outcomes.values())
+    resuming = sum(trial_state(t) == "resumable" for t in to_run)
+    say(f"sweep {path}: {len(trials)} trials, {skipped} finished before, {len(to_run)} to run"
+        + (f" ({resuming} resume from a checkpoint)" if to_run else ""))
+    if to_run and not dry_run:
+        from .distributed import connect, require_ray, sweep_on_ray
+        require_ray()
+        available = connect(address, cpus).get("CPU", 0)
+        say(f"ray: {available:.0f} CPUs, {cpus_per_trial} per trial")
+        for name, result in sweep_on_ray(to_run, cpus_per_trial, say=say).items():
+            outcomes[name] = TrialOutcome(outcomes[name].trial, result["status"], result["seconds"], result["error"])
+    return list(outcomes.values())
+
+
 def last_figures(trial: Trial, episodes: int = 20) -> dict:
     """The mean of the last ``episodes`` rows of the trial's curve.csv: reward, mean and max
     idleness, battery failures ({} without a curve)."""
