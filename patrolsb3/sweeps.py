@@ -260,18 +260,20 @@ def run_sweep(path, out=None, address: str | None = None, cpus: int | None = Non
     trials = read_sweep(path, out=out)
     check_output_dir(trials[0].run_dir.parents[2], "--out")
     outcomes = {t.name: TrialOutcome(t, "pending") for t in trials}
-    to_run = []
+    to_run, resuming = [], 0
     for t in trials:
         problem = check_trial(t)
         if problem:
             outcomes[t.name] = TrialOutcome(t, "error", error=problem)
             say(f"trial {t.name}: refused before it started: {problem}")
-        elif trial_state(t) == "finished":
+            continue
+        state = trial_state(t)          # reads (and checks) its checkpoints once
+        if state == "finished":
             outcomes[t.name] = TrialOutcome(t, "skipped")
         else:
             to_run.append(t)
+            resuming += state == "resumable"
     skipped = sum(o.status == "skipped" for o in outcomes.values())
-    resuming = sum(trial_state(t) == "resumable" for t in to_run)
     say(f"sweep {path}: {len(trials)} trials, {skipped} finished before, {len(to_run)} to run"
         + (f" ({resuming} resume from a checkpoint)" if to_run else ""))
     if to_run and not dry_run:
