@@ -13,7 +13,9 @@
 # default 25,000 for stage 1, 200,000 for stage 2). A run's --timesteps (agent-steps, SB3's
 # count: 40 rows x env steps) is SIM_STEPS x 40 x phases, phases = 2 with same-step messages
 # (rl-msg, rl-intention), 1 without (rl-no-msg): equal simulator steps for every variant. Raise
-# SIM_STEPS and pass --resume to train a stage further.
+# SIM_STEPS and pass --resume to train a stage further. SET: extra KEY=VALUE overrides passed
+# to --set for every run of this call (e.g. SET="ent_coef_message=0.01"; pass the same on
+# --resume, since a resumed run refuses settings other than its own).
 #
 # Stage 1 learns the patrol with the battery out of the way (300-step episodes, full batteries).
 # Stage 2 learns when to swap, unshielded: 1,500-step episodes from 15-100 % batteries, half of
@@ -27,6 +29,7 @@ SECONDS_PER_CALL=${2:?usage: zoo/train_paper_setting.sh 1|2 SECONDS [--resume]}
 RESUME=${3:-}
 RUNS=${RUNS:-"A:rl-msg:0 A:rl-no-msg:0"}
 OUT=${OUT:-runs/paper}
+read -r -a extra_set <<< "${SET:-}"
 # the settings of each stage: the recipes zoo-stage1 and zoo-stage2 (patrolsb3/sb3/recipes.py)
 case "$STAGE" in
   1) SIM=${SIM_STEPS:-25000} ;;
@@ -39,7 +42,8 @@ for run in $RUNS; do
   phases=2; [ "$variant" = rl-no-msg ] && phases=1
   timesteps=$((SIM * 40 * phases))
   init=()
-  if [ "$STAGE" = 2 ] && [ -z "$RESUME" ]; then init=(--init-from "$OUT/stage1/$map/$variant/seed$seed"); fi
+  if [ "${#extra_set[@]}" -gt 0 ]; then init+=(--set "${extra_set[@]}"); fi
+  if [ "$STAGE" = 2 ] && [ -z "$RESUME" ]; then init+=(--init-from "$OUT/stage1/$map/$variant/seed$seed"); fi
   nohup timeout -s INT "$SECONDS_PER_CALL" patrolsb3 train --map "$map" --variant "$variant" --seed "$seed" \
     --timesteps "$timesteps" --out "$OUT/stage$STAGE" --run-id "seed$seed" $RESUME "${init[@]}" \
     --device cpu --no-progress --checkpoint-freq 500000 --eval-freq 0 --recipe "zoo-stage$STAGE" \
