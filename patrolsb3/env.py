@@ -155,8 +155,11 @@ class PatrolParallelEnv(ParallelEnv):
                 act[0, i] = np.asarray(actions[name], dtype=np.int64).reshape(2)
         phase = self.phase
         act = protocol.check_actions(self.cfg, phase, act, self._decision.masks)
-        info = protocol.apply_actions(self.spec_map, self.cfg, self.core_state, phase, act)
-        self._decide(protocol.next_phase(self.cfg, phase))
+        info = protocol.apply_actions(self.spec_map, self.cfg, self.core_state, phase, act,
+                                      self._decision)
+        self._decision = protocol.next_decision(self.spec_map, self.cfg, self.core_state, phase,
+                                                self._decision)
+        self.phase = self._decision.phase
         if info is None:  # a message phase: symbols shown, the simulator did not step
             zeros = {a: 0.0 for a in self.agents}
             falses = {a: False for a in self.agents}
@@ -191,28 +194,29 @@ class PatrolParallelEnv(ParallelEnv):
         n = self.cfg.n_symbols
         battery = (s.battery[0] / self.cfg.b_max).tolist()
         status = s.status[0].tolist()
-        stepped = info is not None
+        phase, t, k = int(self.phase), int(s.t[0]), len(self.agents)
+        if info is None:
+            falses = [False] * k
+            collided = pushed = started = battery_failed = fault_failed = falses
+            swap_battery = [-1.0] * k
+            idle = s.idle[0]
+            collisions, team = 0, 0.0
+            mean_idleness, max_idleness = float(idle.sum() / idle.size), float(idle.max())
+        else:
+            collided, pushed = info.collided[0].tolist(), info.pushed[0].tolist()
+            started = info.swap_started[0].tolist()
+            # -1 (not nan) when no swap started: nan != nan breaks seed checks
+            swap_battery = np.where(info.swap_started[0], info.swap_battery[0], -1.0).tolist()
+            battery_failed, fault_failed = info.battery_failed[0].tolist(), info.fault_failed[0].tolist()
+            collisions, team = int(info.collisions[0]), float(info.team_patrol[0])
+            mean_idleness, max_idleness = float(info.mean_idleness[0]), float(info.max_idleness[0])
         out = {}
-        for i, name in enumerate(self.agents):
-            out[name] = {
-                "action_mask": (masks[i, :n], masks[i, n:]),
-                "action_mask_flat": masks[i],
-                "phase": int(self.phase),
-                "status": int(status[i]),
-                "battery": battery[i],
-                "step": int(s.t[0]),
-                "collided": stepped and bool(info.collided[0, i]),
-                "collisions": int(info.collisions[0]) if stepped else 0,
-                "pushed": stepped and bool(info.pushed[0, i]),
-                "swap_started": stepped and bool(info.swap_started[0, i]),
-                # -1 (not nan) when no swap started: nan != nan breaks seed checks
-                "swap_battery": float(info.swap_battery[0, i]) if stepped and info.swap_started[0, i] else -1.0,
-                "battery_failed": stepped and bool(info.battery_failed[0, i]),
-                "fault_failed": stepped and bool(info.fault_failed[0, i]),
-                "mean_idleness": float(info.mean_idleness[0]) if stepped else float(s.idle[0].mean()),
-                "max_idleness": float(info.max_idleness[0]) if stepped else float(s.idle[0].max()),
-                "team_patrol_reward": float(info.team_patrol[0]) if stepped else 0.0,
-            }
+        for i, name in enumerate(self.agents):   # values in the order of INFO_KEYS
+            row = masks[i]
+            out[name] = dict(zip(INFO_KEYS, (
+                (row[:n], row[n:]), row, phase, status[i], battery[i], t, collided[i], collisions,
+                pushed[i], started[i], swap_battery[i], battery_failed[i], fault_failed[i],
+                mean_idleness, max_idleness, team)))
         return out
 
     # ------------------------------------------------------------------ rendering

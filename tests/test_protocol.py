@@ -146,3 +146,66 @@ def test_protocol_signature_separates_what_changes_the_spaces():
 def test_check_team_refuses_what_is_not_a_whole_number(spec, bad):
     with pytest.raises(ValueError, match="n_agents must be a whole number"):
         protocol.check_team(spec, make_config(), bad)
+
+
+@pytest.mark.parametrize("settings", [{"comm": "learned"}, {"comm": "learned", "message_encoding": "planes"},
+                                      {"comm": "intention", "local_idleness": True},
+                                      {"comm": "learned", "return_guard": True, "init_battery": (0.05, 0.2)},
+                                      {"comm": "none"}, {"comm": "learned", "message_timing": "delayed"}])
+def test_next_decision_equals_deciding_anew(spec, settings):
+    """After a message phase only the symbols are redrawn; the result must be what decide()
+    computes from scratch, for every mode, over random legal play (symbols included)."""
+    cfg = make_config(**settings)
+    state = reset_state(spec, cfg, [1, 3, 5], n_envs=3, seed=4)
+    rng = np.random.default_rng(0)
+    phase = protocol.first_phase(cfg)
+    decision = protocol.decide(spec, cfg, state, phase)
+    reused = 0
+    for _ in range(60):
+        masks = decision.masks                                                # (E, A, n_symbols + 5)
+        n = cfg.n_symbols
+        actions = np.stack([np.argmax(rng.random(masks[..., :n].shape) * masks[..., :n], -1),
+                            np.argmax(rng.random(masks[..., n:].shape) * masks[..., n:], -1)], -1)
+        protocol.apply_actions(spec, cfg, state, phase, actions, decision)
+        new = protocol.next_decision(spec, cfg, state, phase, decision)
+        fresh = protocol.decide(spec, cfg, state, protocol.next_phase(cfg, phase))
+        for field in ("phase", "grid", "vector", "critic", "masks", "move_mask"):
+            np.testing.assert_array_equal(getattr(new, field), getattr(fresh, field), err_msg=field)
+        reused += phase == protocol.MESSAGE_PHASE and (state.messages > 0).any()
+        phase, decision = new.phase, new
+    assert (reused > 0) == cfg.two_phase               # the reuse path ran, with symbols shown
+
+
+def test_the_simulator_checks_moves_against_the_decision_mask_as_against_the_rule(spec):
+    """Moves checked against a decision's move mask: the same verdicts as the rule itself (the
+    same repaired moves, the same refusal), and not the return guard's narrower mask."""
+    from patrolsb3.core.step import check_moves
+    for settings in ({}, {"return_guard": True, "init_battery": (0.02, 0.1)}):
+        cfg = make_config(comm="none", invalid_action="stay", **settings)
+        state = reset_state(spec, cfg, [2, 4, 5], n_envs=3, seed=5)
+        decision = protocol.decide(spec, cfg, state, protocol.MOVE_PHASE)
+        plain = action_mask(spec, state)                                      # (E, A, 5) no guard
+        for move in range(5):
+            moves = np.full(state.pos.shape, move)
+            expected = check_moves(spec, cfg, state, moves)
+            np.testing.assert_array_equal(check_moves(spec, cfg, state, moves, plain), expected)
+            with_decision = copy.deepcopy(state)
+            act = np.stack([np.zeros_like(moves), moves], -1)
+            info = protocol.apply_actions(spec, cfg, with_decision, protocol.MOVE_PHASE, act, decision)
+            without = copy.deepcopy(state)
+            info_rule = protocol.apply_actions(spec, cfg, without, protocol.MOVE_PHASE, act)
+            np.testing.assert_array_equal(with_decision.pos, without.pos)
+            np.testing.assert_array_equal(info.reward, info_rule.reward)
+    strict = make_config(comm="none")
+    state = reset_state(spec, strict, [3], n_envs=1, seed=5)
+    plain = action_mask(spec, state)
+    bad = np.argwhere(~plain[0, :3])
+    if len(bad):
+        slot, move = bad[0]
+        moves = np.full((1, strict.max_agents), STAY)
+        moves[0, slot] = move
+        with pytest.raises(InvalidActionError, match="its action mask forbids") as with_mask:
+            check_moves(spec, strict, state, moves, plain)
+        with pytest.raises(InvalidActionError) as with_rule:
+            check_moves(spec, strict, state, moves)
+        assert str(with_mask.value) == str(with_rule.value)

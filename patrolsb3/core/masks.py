@@ -2,18 +2,25 @@
 the observations, the env's info and the heuristics)."""
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .maps import STATION, STAY, MapSpec
 from .state import State
 
+_STAY_ONLY = np.array([False, False, False, False, True])   # (5,) the mask of an inactive slot
 WAIT_ALLOWANCE = 1.25
 """Extra factor on the trip home for steps spent waiting or yielding in traffic."""
 
 
+@functools.lru_cache(maxsize=64)
 def station_cells(spec: MapSpec) -> np.ndarray:
-    """(H*W,) bool, True on charging stations (cells any number of agents may share)."""
-    return spec.kinds.ravel() == STATION
+    """(H*W,) bool, True on charging stations (cells any number of agents may share); one
+    read-only array per map."""
+    cells = spec.kinds.ravel() == STATION
+    cells.flags.writeable = False
+    return cells
 
 
 def _blocked(spec: MapSpec, state: State, target: np.ndarray) -> np.ndarray:
@@ -121,7 +128,7 @@ def action_mask(spec: MapSpec, state: State, cfg=None) -> np.ndarray:
     target = spec.neighbour[pos]                               # (E, A, 5)
     mask = spec.move_ok[pos] & ~_blocked(spec, state, target)
     mask[..., STAY] = True
-    mask[~state.active] = np.array([False, False, False, False, True])
+    mask = np.where(state.active[..., None], mask, _STAY_ONLY)
     if cfg is not None and cfg.return_guard:
         mask = return_guard(spec, cfg, state, mask)
     return mask

@@ -57,6 +57,8 @@ from .state import ACTIVE, State
 
 VECTOR_SIZE = 15
 """Length of the actor's vector observation without the local idleness."""
+PHASE_INDEX = 6
+"""Index of the phase (0 message, 1 move) in the actor's vector."""
 LOCAL_IDLENESS_SIZE = 5
 """Values the local idleness adds (one per move)."""
 _ONE_HOT = np.eye(5, dtype=np.float32)  # (5, 5) one-hot row of each move
@@ -86,7 +88,8 @@ def home_features(spec: MapSpec, cfg: EnvConfig, state: State) -> np.ndarray:
     steps_home = spec.steps_home[state.pos]                                    # (E, A)
     out = np.empty(state.pos.shape + (7,), dtype=np.float32)
     out[..., 0] = np.minimum(steps_home / (H + W), 1.0)
-    out[..., 1] = np.clip((state.battery - steps_home * cfg.drain[1]) / cfg.b_max, -1.0, 1.0)
+    margin = (state.battery - steps_home * cfg.drain[1]) / cfg.b_max               # (E, A)
+    out[..., 1] = np.minimum(np.maximum(margin, -1.0), 1.0)
     out[..., 2:] = _ONE_HOT[spec.home_move[state.pos]]
     out[~state.active] = 0.0
     return out
@@ -142,6 +145,40 @@ def actor_observation(spec: MapSpec, cfg: EnvConfig, state: State, phase: int = 
     """
     E, A = state.pos.shape
     H, W = spec.shape
+    grid = np.zeros((E, A, grid_channels(cfg), H * W), dtype=np.float32)       # (E, A, C, H*W)
+    draw_positions(spec, cfg, state, grid)
+    f = normalised_idleness(state.idle, state.visited, cfg.c_norm)              # (E, V)
+    chan1 = np.repeat(_idleness_base(spec)[None], E, axis=0)                    # (E, H*W)
+    chan1[:, spec.vertex_cells] = f
+    grid[:, :, 1] = chan1[:, None, :]
+
+    if mask is None:
+        mask = action_mask(spec, state, cfg)
+    active = state.active                                                      # (E, A)
+    vector = np.empty((E, A, vector_size(cfg)), dtype=np.float32)
+    vector[..., 0] = state.battery / cfg.b_max
+    vector[..., 1:6] = mask
+    vector[..., PHASE_INDEX] = phase
+    vector[..., 7] = active
+    vector[..., 8:VECTOR_SIZE] = home_features(spec, cfg, state)
+    if cfg.local_idleness:
+        target = spec.neighbour[state.pos]                                     # (E, A, 5)
+        local = np.take_along_axis(chan1, target.reshape(E, A * 5), axis=1).reshape(E, A, 5)
+        local[~spec.move_ok[state.pos]] = -1.0                                 # off map, obstacle
+        local[~active] = 0.0
+        vector[..., VECTOR_SIZE:] = local
+    return grid.reshape(E, A, grid.shape[2], H, W), vector
+
+
+def draw_positions(spec: MapSpec, cfg: EnvConfig, state: State, grid: np.ndarray) -> None:
+    """Write the part of every slot's grid that the symbols shown can change, in place:
+    channel 0 (positions, and the symbols with 'scalar' messages) and, with 'planes'
+    messages, the symbol planes (channels 2 ..). Channel 1 (idleness) is left as it is.
+
+    Args:
+        grid: (E, A, grid_channels(cfg), H*W) float32, overwritten on those channels.
+    """
+    E, A = state.pos.shape
     planes = cfg.message_encoding == "planes"
     kinds = spec.kinds.ravel()
     active = state.active                                                      # (E, A)
@@ -152,38 +189,17 @@ def actor_observation(spec: MapSpec, cfg: EnvConfig, state: State, phase: int = 
         other = -own
     # what every observer sees of the others: agents off the station (active agents never
     # share a cell off the station, so no two writes collide)
-    shared = np.broadcast_to(_position_base(spec, planes), (E, H * W)).copy()  # (E, H*W)
+    shared = np.repeat(_position_base(spec, planes)[None], E, axis=0)         # (E, H*W)
     drawn = active & (kinds != STATION)[state.pos]                             # (E, A)
     e_d, j_d = np.nonzero(drawn)
     shared[e_d, state.pos[e_d, j_d]] = other[e_d, j_d]
-    grid = np.zeros((E, A, grid_channels(cfg), H * W), dtype=np.float32)
     grid[:, :, 0] = shared[:, None, :]
     # each active observer sees itself positive on its own cell (station included)
     e_s, i_s = np.nonzero(active)
     grid[e_s, i_s, 0, state.pos[e_s, i_s]] = own[e_s, i_s]
     if planes:
+        grid[:, :, 2:] = 0.0
         _draw_symbol_planes(grid, state, drawn)
-
-    f = normalised_idleness(state.idle, state.visited, cfg.c_norm)              # (E, V)
-    chan1 = np.broadcast_to(_idleness_base(spec), (E, H * W)).copy()            # (E, H*W)
-    chan1[:, spec.vertex_cells] = f
-    grid[:, :, 1] = chan1[:, None, :]
-
-    if mask is None:
-        mask = action_mask(spec, state, cfg)
-    vector = np.empty((E, A, vector_size(cfg)), dtype=np.float32)
-    vector[..., 0] = state.battery / cfg.b_max
-    vector[..., 1:6] = mask
-    vector[..., 6] = phase
-    vector[..., 7] = active
-    vector[..., 8:VECTOR_SIZE] = home_features(spec, cfg, state)
-    if cfg.local_idleness:
-        target = spec.neighbour[state.pos]                                     # (E, A, 5)
-        local = np.take_along_axis(chan1, target.reshape(E, A * 5), axis=1).reshape(E, A, 5)
-        local[~spec.move_ok[state.pos]] = -1.0                                 # off map, obstacle
-        local[~active] = 0.0
-        vector[..., VECTOR_SIZE:] = local
-    return grid.reshape(E, A, grid.shape[2], H, W), vector
 
 
 def critic_state(spec: MapSpec, cfg: EnvConfig, state: State) -> np.ndarray:
@@ -198,5 +214,8 @@ def critic_state(spec: MapSpec, cfg: EnvConfig, state: State) -> np.ndarray:
     pos = np.where(present, state.pos, spec.station)
     battery = np.where(present, state.battery / cfg.b_max, 1.0)
     row, col = np.divmod(pos, W)
-    out = np.stack([battery, row / max(H - 1, 1), col / max(W - 1, 1)], axis=-1)  # (E, A, 3)
-    return out.reshape(E, 3 * A).astype(np.float32)
+    out = np.empty((E, A, 3), dtype=np.float32)
+    out[..., 0] = battery
+    out[..., 1] = row / max(H - 1, 1)
+    out[..., 2] = col / max(W - 1, 1)
+    return out.reshape(E, 3 * A)

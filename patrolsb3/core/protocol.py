@@ -28,7 +28,7 @@ import numpy as np
 from .config import EnvConfig
 from .maps import STAY, MapSpec
 from .masks import action_mask, composite_action_mask
-from .observe import actor_observation, critic_state, grid_channels, vector_size
+from .observe import PHASE_INDEX, actor_observation, critic_state, draw_positions, grid_channels, vector_size
 from .state import State
 from .step import InvalidActionError, StepInfo
 from .step import step as core_step
@@ -166,6 +166,8 @@ class Decision:
         vector: (E, A, vector_size) float32 actor vectors.
         critic: (E, 3 * max_agents) float32 centralised state.
         masks: (E, A, n_symbols + 5) bool composite masks (message, then move).
+        move_mask: (E, A, 5) bool moves the state allows (:func:`patrolsb3.core.masks.action_mask`),
+            whatever the phase (in a message phase the composite mask allows Stay only).
     """
 
     phase: int
@@ -173,6 +175,7 @@ class Decision:
     vector: np.ndarray
     critic: np.ndarray
     masks: np.ndarray
+    move_mask: np.ndarray
 
     def flat(self, layout: ObservationLayout) -> np.ndarray:
         """(E, A, layout.size) float32 flat rows, every slot with its episode's critic part."""
@@ -188,7 +191,35 @@ def decide(spec: MapSpec, cfg: EnvConfig, state: State, phase: int) -> Decision:
     message, move = composite_action_mask(spec, cfg, state, message_phase=phase == MESSAGE_PHASE,
                                           move_mask=move_mask)
     return Decision(phase, grid, vector, critic_state(spec, cfg, state),
-                    np.concatenate([message, move], axis=-1))
+                    np.concatenate([message, move], axis=-1), move_mask)
+
+
+def next_decision(spec: MapSpec, cfg: EnvConfig, state: State, applied_phase: int,
+                  previous: Decision) -> Decision:
+    """The decision of the phase after ``applied_phase``, once its actions were applied to
+    ``state`` (:func:`apply_actions`); equal to :func:`decide` of that phase.
+
+    A message phase changes nothing but the symbols shown, so the move phase after it keeps
+    what symbols cannot change (idleness channel, vector, critic state, move mask) from
+    ``previous``, the message phase's decision, and redraws only the position and symbol
+    channels; after a move phase (the simulator stepped) everything is computed anew.
+
+    Args:
+        applied_phase: the phase whose actions were just applied.
+        previous: the decision of ``applied_phase`` (the one those actions answered).
+    """
+    phase = next_phase(cfg, applied_phase)
+    if applied_phase != MESSAGE_PHASE or phase != MOVE_PHASE:
+        return decide(spec, cfg, state, phase)
+    E, A = state.pos.shape
+    grid = previous.grid.copy()                                                # (E, A, C, H, W)
+    draw_positions(spec, cfg, state, grid.reshape(E, A, grid.shape[2], -1))
+    vector = previous.vector.copy()                                            # (E, A, vector_size)
+    vector[..., PHASE_INDEX] = phase
+    message, move = composite_action_mask(spec, cfg, state, message_phase=False,
+                                          move_mask=previous.move_mask)
+    return Decision(phase, grid, vector, previous.critic, np.concatenate([message, move], axis=-1),
+                    previous.move_mask)
 
 
 def agent_label(episode: int, slot: int, n_envs: int) -> str:
@@ -243,7 +274,7 @@ def check_actions(cfg: EnvConfig, phase: int, actions: np.ndarray, masks: np.nda
 
 
 def apply_actions(spec: MapSpec, cfg: EnvConfig, state: State, phase: int,
-                  actions: np.ndarray) -> StepInfo | None:
+                  actions: np.ndarray, decision: Decision | None = None) -> StepInfo | None:
     """Carry out one phase's checked actions on ``state``, in place.
 
     A message phase shows the symbols (``state.messages``) and returns None; a move phase steps
@@ -253,16 +284,21 @@ def apply_actions(spec: MapSpec, cfg: EnvConfig, state: State, phase: int,
 
     Args:
         actions: (E, A, 2) int64 from :func:`check_actions`.
+        decision: the decision these actions answer, if the caller has it: the simulator then
+            checks the moves against its move mask instead of evaluating the rule again (not
+            with the return guard, whose narrower mask the simulator does not apply).
     """
     active = state.active
+    allowed = None if decision is None or cfg.return_guard else decision.move_mask
     if phase == MESSAGE_PHASE:
         state.messages = symbols_of(actions[..., 0], active)
         return None
     if cfg.comm == "none" or cfg.two_phase:
-        info = core_step(spec, cfg, state, actions[..., 1])
+        info = core_step(spec, cfg, state, actions[..., 1], allowed=allowed)
     else:  # delayed messages: chosen now, shown at the next step
         symbols = symbols_of(actions[..., 0], active)
-        info = core_step(spec, cfg, state, actions[..., 1], messages=np.zeros_like(symbols))
+        info = core_step(spec, cfg, state, actions[..., 1], messages=np.zeros_like(symbols),
+                         allowed=allowed)
         state.messages = np.where(state.active, symbols, 0)
     if cfg.two_phase:
         state.messages = np.zeros_like(state.messages)

@@ -65,11 +65,15 @@ class StepInfo:
     terminated: np.ndarray      # (E,) bool, every deployed agent has failed
 
 
-def check_moves(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray) -> np.ndarray:
+def check_moves(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
+                allowed: np.ndarray | None = None) -> np.ndarray:
     """Validate moves against the action mask.
 
     Args:
         moves: (E, A) int action per slot (inactive slots are forced to Stay).
+        allowed: (E, A, 5) bool, :func:`patrolsb3.core.masks.action_mask` of ``state`` without
+            the return guard, when the caller already has it; else the rule is evaluated for
+            the chosen moves only.
 
     Returns:
         (E, A) int64 moves, invalid ones replaced by Stay when cfg.invalid_action == 'stay'.
@@ -80,11 +84,14 @@ def check_moves(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray) 
     moves = np.asarray(moves, dtype=np.int64)
     if moves.shape != state.pos.shape:
         raise ValueError(f"moves must have shape {state.pos.shape} (n_envs, max_agents), got {moves.shape}")
-    if ((moves < 0) | (moves > STAY)).any():
+    if (moves.view(np.uint64) > STAY).any():     # negative moves wrap to huge values
         bad = moves[(moves < 0) | (moves > STAY)][0]
         raise InvalidActionError(f"move {bad} outside 0..4 ({', '.join(ACTION_NAMES)})")
     moves = np.where(state.active, moves, STAY)
-    ok = move_allowed(spec, state, moves)                                     # (E, A)
+    if allowed is None:
+        ok = move_allowed(spec, state, moves)                                 # (E, A)
+    else:
+        ok = allowed.reshape(-1, allowed.shape[-1])[np.arange(moves.size), moves.ravel()].reshape(moves.shape)
     if not ok.all():
         if cfg.invalid_action == "raise":
             e, a = np.argwhere(~ok)[0]
@@ -161,7 +168,8 @@ def resolve_collisions(spec: MapSpec, pos: np.ndarray, target: np.ndarray, activ
 
 
 def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
-         messages: np.ndarray | None = None, compute_reward: bool = True) -> StepInfo:
+         messages: np.ndarray | None = None, compute_reward: bool = True,
+         allowed: np.ndarray | None = None) -> StepInfo:
     """Advance every episode of ``state`` by one step, in place.
 
     Args:
@@ -172,6 +180,8 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
         messages: (E, A) int symbols 0..n_symbols shown this step (0 = silent), or None to
             keep ``state.messages`` (they are cleared for inactive slots).
         compute_reward: skip the reward arithmetic when False (heuristic evaluation).
+        allowed: (E, A, 5) the unguarded action mask of ``state`` if already computed
+            (:func:`check_moves`).
 
     Returns:
         A :class:`StepInfo`.
@@ -185,7 +195,7 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
     else:
         state.messages = np.where(acted, state.messages, 0)
     # 2. moves, checked against the mask
-    moves = check_moves(spec, cfg, state, moves)
+    moves = check_moves(spec, cfg, state, moves, allowed)
     pos = state.pos
     shaping = compute_reward and cfg.c_home > 0
     if shaping:
@@ -255,7 +265,7 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
         reward_collision=reward_collision, reward_home=reward_home, acted=acted, pushed=pushed,
         collided=collided, collisions=collisions, swap_started=arrived, swap_battery=swap_battery,
         swap_ended=swap_ended, battery_failed=battery_failed, fault_failed=fault_failed,
-        team_patrol=team, mean_idleness=state.idle.mean(axis=1),
+        team_patrol=team, mean_idleness=state.idle.sum(axis=1) / state.idle.shape[1],
         max_idleness=state.idle.max(axis=1), truncated=state.t >= cfg.episode_steps,
         terminated=((state.status == FAILED) | (state.n_agents[:, None] <= np.arange(A))).all(axis=1))
 

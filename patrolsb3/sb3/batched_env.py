@@ -44,6 +44,7 @@ class EpisodeGroup:
         episodes: (G,) int64 indices among all parallel episodes.
         rows: (G * max_agents,) int64 their rows (episode-major, then slot).
         state: the batched ``State`` of these G episodes (set by the env's reset).
+        decision: their :class:`patrolsb3.core.protocol.Decision` of the current phase.
     """
 
     def __init__(self, cfg: EnvConfig, episodes: Sequence[int]):
@@ -52,6 +53,7 @@ class EpisodeGroup:
         A = cfg.max_agents
         self.rows = (self.episodes[:, None] * A + np.arange(A)).reshape(-1)
         self.state = None
+        self.decision = None
 
 
 class BatchedPatrolEnv(ParallelEnv):
@@ -165,7 +167,10 @@ class BatchedPatrolEnv(ParallelEnv):
             e, rows = group.episodes, group.rows
             group_act = protocol.check_actions(group.cfg, phase, act[rows].reshape(len(e), A, 2),
                                                self.masks[rows].reshape(len(e), A, -1))
-            info = protocol.apply_actions(self.spec_map, group.cfg, group.state, phase, group_act)
+            info = protocol.apply_actions(self.spec_map, group.cfg, group.state, phase, group_act,
+                                          group.decision)
+            group.decision = protocol.next_decision(self.spec_map, group.cfg, group.state, phase,
+                                                    group.decision)
             if info is None:
                 continue
             rewards[rows] = info.reward.reshape(-1)
@@ -186,7 +191,7 @@ class BatchedPatrolEnv(ParallelEnv):
             for k in range(e * A, (e + 1) * A):
                 extra[k] = {"episode": {"r": float(self._returns[k]), "l": int(self._lengths[k])},
                             "team_episode": dict(summary)}
-        self._decide(protocol.next_phase(self.cfg, phase))
+        self._show(protocol.next_phase(self.cfg, phase))
         if ended.any() and not ended.all():   # restart these now; all at once is SuperSuit's reset
             for k in np.flatnonzero(np.repeat(ended, A)):
                 extra[k]["terminal_observation"] = self.observations[k].copy()
@@ -220,13 +225,19 @@ class BatchedPatrolEnv(ParallelEnv):
         self._decide(protocol.first_phase(self.cfg))
 
     def _decide(self, phase: int) -> None:
-        """Enter ``phase``: every row's flat observation and mask, one call per group (new
+        """Enter ``phase`` from the current states: every group's decision computed anew."""
+        for group in self.groups:
+            group.decision = protocol.decide(self.spec_map, group.cfg, group.state, phase)
+        self._show(phase)
+
+    def _show(self, phase: int) -> None:
+        """Every row's flat observation and mask from the groups' decisions of ``phase`` (new
         arrays: the rows handed out before, terminal observations among them, stay as they were)."""
         self.phase = phase
         self.observations = np.empty_like(self.observations)
         self.masks = np.empty_like(self.masks)
         for group in self.groups:
-            decision = protocol.decide(self.spec_map, group.cfg, group.state, phase)
+            decision = group.decision
             if len(self.groups) == 1:
                 self.observations = decision.flat(self.layout).reshape(len(group.rows), -1)
                 self.masks = decision.masks.reshape(len(group.rows), -1)
