@@ -217,3 +217,89 @@ def test_ent_coef_message_is_refused_where_it_means_nothing():
     hp = resolve_hyperparams("A", overrides={"algo": "MaskablePPO", "ent_coef_message": 0.01})
     with pytest.raises(ValueError, match="ent_coef_message is a setting of MaskableRecurrentPPO"):
         check_run_settings(hp, 1000)
+
+
+def planes_model(variant="rl-msg", **algo_kwargs):
+    env = make_vec_env(parse_map(NON_SQUARE, name="ns"), agents=(2, 3, 3), variant=variant, seed=0,
+                       max_agents=3, episode_steps=6, message_encoding="planes")
+    model = MaskableRecurrentPPO(PatrolRecurrentPolicy, env, n_steps=16, batch_size=50, n_epochs=1, seed=0,
+                                 device="cpu", policy_kwargs=policy_kwargs_for(env.layout, dense_sizes=(32, 32),
+                                                                                lstm_hidden_size=16),
+                                 **algo_kwargs)
+    return model, env
+
+
+def test_the_signalling_term_is_the_entropy_of_the_mean_symbol_minus_the_mean_entropy():
+    model, _ = planes_model(signal_coef=0.5)
+    data = next(collect(model).get(None))
+    mask = data.mask > 1e-8
+    loss, terms = model.minibatch_loss(data, clip_range=0.15)
+    with th.no_grad():
+        _, _, _, dist = model.policy.evaluate_actions(data.observations, data.actions, data.lstm_states,
+                                                      data.episode_starts, action_masks=data.action_masks,
+                                                      with_distribution=True)
+    probs = dist.distributions[0].probs.numpy()                               # (n, 16)
+    speaking = (mask & (data.action_masks[:, :16].sum(dim=1) > 1)).numpy()
+    p = probs[speaking]
+    mean = p.mean(axis=0)
+    expected = -(mean * np.log(mean)).sum() - (-(p * np.log(np.where(p > 0, p, 1))).sum(axis=1)).mean()
+    assert terms["signalling"] == pytest.approx(expected, rel=1e-4, abs=1e-6)
+    model.signal_coef = None                                                  # the default: no term
+    plain, plain_terms = model.minibatch_loss(data, clip_range=0.15)
+    assert "signalling" not in plain_terms
+    assert loss.item() == pytest.approx(plain.item() - 0.5 * terms["signalling"], rel=1e-5, abs=1e-6)
+
+
+def test_the_listening_term_compares_the_moves_with_and_without_the_received_symbols():
+    model, _ = planes_model(listen_coef=2.0)
+    data = next(collect(model).get(None))
+    mask = data.mask > 1e-8
+    loss, terms = model.minibatch_loss(data, clip_range=0.15)
+    C, H, W = model.policy.features_extractor_kwargs["grid_shape"]
+    obs = data.observations
+    planes = obs[:, 2 * H * W:C * H * W]
+    rows = (mask & (planes < 0).any(dim=1) & (data.action_masks[:, 16:].sum(dim=1) > 1)
+            & (obs[:, C * H * W + 6] > 0.5))
+    assert 0 < int(rows.sum()) < int(mask.sum())          # move rows that heard something, not all
+    silent = obs.clone()
+    silent[:, 2 * H * W:C * H * W] = th.where(planes < 0, th.zeros_like(planes), planes)
+    with th.no_grad():   # (SB3's policy refills one distribution object: copy the probs out)
+        heard, _ = model.policy.get_distribution(obs, data.lstm_states.pi, data.episode_starts, data.action_masks)
+        heard = heard.distributions[1].probs.clone()
+        unheard, _ = model.policy.get_distribution(silent, data.lstm_states.pi, data.episode_starts,
+                                                   data.action_masks)
+        unheard = unheard.distributions[1].probs.clone()
+    expected = (heard[rows] - unheard[rows]).abs().sum(1).mean()
+    assert terms["listening"] == pytest.approx(expected.item(), rel=1e-4)
+    assert terms["listening"] > 0                         # an untrained policy already hears a little
+    model.listen_coef = None
+    plain, _ = model.minibatch_loss(data, clip_range=0.15)
+    assert loss.item() == pytest.approx(plain.item() - 2.0 * terms["listening"], rel=1e-5, abs=1e-6)
+    # the bonus has a gradient (through the heard branch only) that reaches the actor's convolutions
+    model.policy.optimizer.zero_grad()
+    model.listening(model.policy.evaluate_actions(data.observations, data.actions, data.lstm_states,
+                                                  data.episode_starts, action_masks=data.action_masks,
+                                                  with_distribution=True)[3], data, mask).backward()
+    conv = model.policy.pi_features_extractor.conv[0].weight.grad
+    assert conv is not None and float(conv.abs().sum()) > 0
+    # without messages nothing is received: the term is 0 and takes no work
+    quiet, _ = planes_model(variant="rl-no-msg", listen_coef=2.0)
+    _, quiet_terms = quiet.minibatch_loss(next(collect(quiet).get(None)), clip_range=0.15)
+    assert quiet_terms["listening"] == 0.0
+
+
+def test_listening_and_signalling_settings_are_refused_where_they_mean_nothing():
+    with pytest.raises(ValueError, match="listen_coef needs legible messages"):
+        MaskableRecurrentPPO(PatrolRecurrentPolicy, tiny_model()[1], listen_coef=1.0,
+                             policy_kwargs=policy_kwargs_for(tiny_model()[1].layout))
+    with pytest.raises(ValueError, match="signal_coef must be a number"):
+        MaskableRecurrentPPO(PatrolRecurrentPolicy, tiny_model()[1], signal_coef="yes")
+    from patrolsb3.sb3.train import check_run_settings, resolve_hyperparams
+    hp = resolve_hyperparams("A", overrides={"listen_coef": 0.1})
+    with pytest.raises(ValueError, match="listen_coef needs legible messages: set env.message_encoding=planes"):
+        check_run_settings(hp, 1000)
+    hp = resolve_hyperparams("A", overrides={"listen_coef": 0.1, "env": {"message_encoding": "planes"}})
+    check_run_settings(hp, 1000)
+    hp = resolve_hyperparams("A", overrides={"algo": "MaskablePPO", "signal_coef": 0.1})
+    with pytest.raises(ValueError, match="signal_coef is a setting of MaskableRecurrentPPO"):
+        check_run_settings(hp, 1000)

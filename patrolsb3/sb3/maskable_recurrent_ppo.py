@@ -30,6 +30,7 @@ from sb3_contrib.common.recurrent.type_aliases import RNNStates
 from stable_baselines3.common.utils import explained_variance, obs_as_tensor
 from stable_baselines3.common.vec_env import VecEnv
 
+from ..core.observe import PHASE_INDEX
 from .buffers import MaskableRecurrentRolloutBuffer
 from .policy import PatrolRecurrentPolicy
 
@@ -68,7 +69,8 @@ class MaskableRecurrentPPO(RecurrentPPO):
 
     policy_aliases: ClassVar[dict] = {"PatrolRecurrentPolicy": PatrolRecurrentPolicy}
 
-    def __init__(self, *args, n_minibatches: int | None = None, ent_coef_message: float | None = None, **kwargs):
+    def __init__(self, *args, n_minibatches: int | None = None, ent_coef_message: float | None = None,
+                 signal_coef: float | None = None, listen_coef: float | None = None, **kwargs):
         """Args as :class:`sb3_contrib.RecurrentPPO`, plus
 
         Args:
@@ -79,15 +81,32 @@ class MaskableRecurrentPPO(RecurrentPPO):
                 head has a choice (the message phases of rl-msg), not diluted over every row,
                 and ``ent_coef`` then weighs the move head's entropy alone. None (default): one
                 ``ent_coef`` on the summed entropy of both heads over every row, as SB3.
+            signal_coef: weight of a positive-signalling bonus (OURS, after Eccles et al. 2019):
+                over a minibatch's rows where the message head has a choice, the entropy of the
+                mean symbol distribution minus the mean entropy of each row's, an estimate of
+                the mutual information between what a speaker sees and the symbol it sends.
+                None or 0: none.
+            listen_coef: weight of a positive-listening bonus (OURS, after Eccles et al. 2019):
+                over move rows that received symbols and have a choice of move, the L1 distance
+                between the move distribution and the same policy's move distribution with the
+                received symbols removed (the others' symbol planes cleared; that branch is
+                computed without gradient). Needs legible messages (``message_encoding``
+                'planes'). None or 0: none.
         """
         if n_minibatches is not None and int(n_minibatches) < 1:
             raise ValueError(f"n_minibatches must be >= 1, got {n_minibatches}")
-        if ent_coef_message is not None and (isinstance(ent_coef_message, bool) or
-                                             not isinstance(ent_coef_message, (int, float))):
-            raise ValueError(f"ent_coef_message must be a number or None, got {ent_coef_message!r}")
+        for name, value in (("ent_coef_message", ent_coef_message), ("signal_coef", signal_coef),
+                            ("listen_coef", listen_coef)):
+            if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
+                raise ValueError(f"{name} must be a number or None, got {value!r}")
         self.n_minibatches = None if n_minibatches is None else int(n_minibatches)
         self.ent_coef_message = None if ent_coef_message is None else float(ent_coef_message)
+        self.signal_coef = None if signal_coef is None else float(signal_coef)
+        self.listen_coef = None if listen_coef is None else float(listen_coef)
         super().__init__(*args, **kwargs)
+        if self.listen_coef and self.policy.features_extractor_kwargs["grid_shape"][0] <= 2:
+            raise ValueError("listen_coef needs legible messages (env.message_encoding=planes): with "
+                             "'scalar' messages the received symbols have no channel of their own")
 
     def update_batch_size(self) -> int:
         """Rows per minibatch of the coming update (``n_minibatches`` splits the rollout)."""
@@ -205,7 +224,7 @@ class MaskableRecurrentPPO(RecurrentPPO):
         clip_range = self.clip_range(self._current_progress_remaining)
         clip_range_vf = self.clip_range_vf(self._current_progress_remaining) if self.clip_range_vf is not None else None
         entropy_losses, pg_losses, value_losses, clip_fractions, approx_kl_divs = [], [], [], [], []
-        message_entropy_losses = []
+        extra_terms = {}                          # optional terms: message entropy, signalling, listening
         continue_training = True
         for epoch in range(self.n_epochs):
             approx_kl_divs = []
@@ -215,8 +234,9 @@ class MaskableRecurrentPPO(RecurrentPPO):
                 clip_fractions.append(terms["clip_fraction"])
                 value_losses.append(terms["value_loss"])
                 entropy_losses.append(terms["entropy_loss"])
-                if "message_entropy_loss" in terms:
-                    message_entropy_losses.append(terms["message_entropy_loss"])
+                for key in ("message_entropy_loss", "signalling", "listening"):
+                    if key in terms:
+                        extra_terms.setdefault(key, []).append(terms[key])
                 approx_kl_div = terms["approx_kl"]
                 approx_kl_divs.append(approx_kl_div)
                 if self.target_kl is not None and approx_kl_div > 1.5 * self.target_kl:
@@ -233,8 +253,8 @@ class MaskableRecurrentPPO(RecurrentPPO):
                 break
         explained_var = explained_variance(self.rollout_buffer.values.flatten(), self.rollout_buffer.returns.flatten())
         self.logger.record("train/entropy_loss", np.mean(entropy_losses))
-        if message_entropy_losses:
-            self.logger.record("train/message_entropy_loss", np.mean(message_entropy_losses))
+        for key, values in extra_terms.items():
+            self.logger.record(f"train/{key}", np.mean(values))
         self.logger.record("train/policy_gradient_loss", np.mean(pg_losses))
         self.logger.record("train/value_loss", np.mean(value_losses))
         self.logger.record("train/approx_kl", np.mean(approx_kl_divs))
@@ -265,9 +285,11 @@ class MaskableRecurrentPPO(RecurrentPPO):
         if row_mask is not None:
             mask = mask & row_mask
         message_coef = getattr(self, "ent_coef_message", None)      # absent in older checkpoints
-        values, log_prob, entropy = self.policy.evaluate_actions(
+        signal_coef = getattr(self, "signal_coef", None) or 0.0
+        listen_coef = getattr(self, "listen_coef", None) or 0.0
+        values, log_prob, entropy, distribution = self.policy.evaluate_actions(
             data.observations, data.actions, data.lstm_states, data.episode_starts,
-            action_masks=data.action_masks, per_head=message_coef is not None)
+            action_masks=data.action_masks, per_head=message_coef is not None, with_distribution=True)
         values = values.flatten()
         advantages = data.advantages
         if self.normalize_advantage and int(mask.sum()) > 1:   # as SB3's PPO: not over a single row
@@ -294,6 +316,14 @@ class MaskableRecurrentPPO(RecurrentPPO):
             loss = (policy_loss + self.ent_coef * entropy_loss + message_coef * message_entropy_loss
                     + self.vf_coef * value_loss)
             terms["message_entropy_loss"] = message_entropy_loss.item()
+        if signal_coef:
+            signalling = self.signalling(distribution, data.action_masks, mask)
+            loss = loss - signal_coef * signalling
+            terms["signalling"] = signalling.item()
+        if listen_coef:
+            listening = self.listening(distribution, data, mask)
+            loss = loss - listen_coef * listening
+            terms["listening"] = listening.item()
         with th.no_grad():
             log_ratio = log_prob - data.old_log_prob
             approx_kl = th.mean(((th.exp(log_ratio) - 1) - log_ratio)[mask]).item()
@@ -301,6 +331,53 @@ class MaskableRecurrentPPO(RecurrentPPO):
         return loss, {"policy_loss": policy_loss.item(), "value_loss": value_loss.item(),
                       "entropy_loss": entropy_loss.item(), "clip_fraction": clip_fraction,
                       "approx_kl": approx_kl, **terms}
+
+    def signalling(self, distribution, action_masks: th.Tensor, mask: th.Tensor) -> th.Tensor:
+        """The positive-signalling term of a minibatch: H(mean symbol distribution) - mean H(symbol
+        distribution of a row), over the real rows whose message head has a choice (0 if none).
+
+        Args:
+            distribution: the masked distribution of the minibatch (message head first).
+            action_masks: (n, n_symbols + 5) the rows' masks.
+            mask: (n,) bool real rows.
+        """
+        n_messages = int(self.action_space.nvec[0])
+        speaking = mask & (action_masks[:, :n_messages].sum(dim=1) > 1)            # (n,)
+        if not bool(speaking.any()):
+            return action_masks.new_zeros((), dtype=th.float32)
+        head = distribution.distributions[0]
+        probs = head.probs[speaking]                                               # (k, n_symbols)
+        mean = probs.mean(dim=0)                                                   # (n_symbols,)
+        mean_entropy = -(mean * th.log(mean.clamp_min(1e-12))).sum()
+        return mean_entropy - head.entropy()[speaking].mean()
+
+    def listening(self, distribution, data, mask: th.Tensor) -> th.Tensor:
+        """The positive-listening term of a minibatch: mean L1 distance between each listening
+        row's move distribution and the one the policy gives with the received symbols removed
+        (computed without gradient, from the same LSTM states), 0 if no row listens.
+
+        A row listens when it is real, in a move phase, has received a symbol (a -1 on one of
+        the others' symbol planes) and has more than one legal move.
+        """
+        C, H, W = self.policy.features_extractor_kwargs["grid_shape"]
+        obs = data.observations
+        planes = obs[:, 2 * H * W:C * H * W]                                       # (n, n_symbols*H*W)
+        n_messages = int(self.action_space.nvec[0])
+        received = (planes < 0).any(dim=1)
+        choice = data.action_masks[:, n_messages:].sum(dim=1) > 1
+        move_phase = obs[:, C * H * W + PHASE_INDEX] > 0.5
+        rows = mask & received & choice & move_phase                               # (n,)
+        if not bool(rows.any()):
+            return obs.new_zeros(())
+        # read before the second pass: SB3's policy keeps one distribution object and refills it
+        heard = distribution.distributions[1].probs[rows]                          # (k, 5)
+        silent = obs.clone()
+        silent[:, 2 * H * W:C * H * W] = planes.clamp_min(0.0)                     # own symbol kept
+        with th.no_grad():
+            unheard, _ = self.policy.get_distribution(silent, data.lstm_states.pi, data.episode_starts,
+                                                      data.action_masks)
+            unheard_probs = unheard.distributions[1].probs[rows]                   # (k, 5)
+        return (heard - unheard_probs).abs().sum(dim=1).mean()
 
     def predict(self, observation, state=None, episode_start=None, deterministic: bool = False, action_masks=None):
         """Actions and the next LSTM state; ``action_masks`` (n, 21) restricts the choice.

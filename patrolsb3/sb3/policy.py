@@ -263,14 +263,18 @@ class PatrolRecurrentPolicy(_RoleExtractorMixin, RecurrentActorCriticPolicy):
         return actions.reshape((-1, *self.action_space.shape)), self.value_net(latent_vf), log_prob, states
 
     def evaluate_actions(self, obs: th.Tensor, actions: th.Tensor, lstm_states: RNNStates,
-                         episode_starts: th.Tensor, action_masks=None, per_head: bool = False):
+                         episode_starts: th.Tensor, action_masks=None, per_head: bool = False,
+                         with_distribution: bool = False):
         """Values (B, 1), log-probs (B,) and entropies (B,) of the given actions; with
-        ``per_head`` the entropies are (B, 2): message head, move head."""
+        ``per_head`` the entropies are (B, 2): message head, move head; with
+        ``with_distribution`` the masked distribution comes fourth (its ``distributions`` are
+        the message and move heads)."""
         latent_pi, latent_vf, _ = self._latents(obs, lstm_states, episode_starts)
         distribution = self._masked_distribution(latent_pi, action_masks)
         entropy = (th.stack([d.entropy() for d in distribution.distributions], dim=1) if per_head
                    else distribution.entropy())
-        return self.value_net(latent_vf), distribution.log_prob(actions), entropy
+        out = self.value_net(latent_vf), distribution.log_prob(actions), entropy
+        return (*out, distribution) if with_distribution else out
 
     def get_distribution(self, obs: th.Tensor, lstm_states, episode_starts: th.Tensor, action_masks=None):
         """The (masked) action distribution and the actor's new LSTM states."""

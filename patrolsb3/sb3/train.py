@@ -27,7 +27,9 @@ from .hyperparams import load_hyperparams, merge, per_phase, schedule
 
 ALGO_KEYS = ("learning_rate", "n_steps", "n_epochs", "gamma", "gae_lambda", "clip_range", "ent_coef",
              "vf_coef", "max_grad_norm", "n_minibatches", "batch_size", "policy_kwargs", "target_kl",
-             "ent_coef_message")
+             "ent_coef_message", "signal_coef", "listen_coef")
+COMMUNICATION_KEYS = ("ent_coef_message", "signal_coef", "listen_coef")
+"""Optional coefficients of MaskableRecurrentPPO for learned messages (None: off)."""
 RUN_KEYS = ("algo", "timesteps", "n_envs", "curriculum", "env", "checkpoint_freq", "eval_freq",
             "eval_episode_steps", "eval_episodes", "torch_threads", "normalize_reward", "mix")
 
@@ -127,10 +129,11 @@ def algorithm_kwargs(hp: dict, spec, layout, phases_per_step: int, rows: int) ->
     if n_minibatches is None and batch_size is None:
         raise ValueError("give batch_size (rows per minibatch) or n_minibatches")
     extra = {}
-    if hp.get("ent_coef_message") is not None:
-        if spec.name != "MaskableRecurrentPPO":
-            raise ValueError(f"ent_coef_message is a setting of MaskableRecurrentPPO, not of {spec.name}")
-        extra["ent_coef_message"] = float(hp["ent_coef_message"])
+    for key in COMMUNICATION_KEYS:
+        if hp.get(key) is not None:
+            if spec.name != "MaskableRecurrentPPO":
+                raise ValueError(f"{key} is a setting of MaskableRecurrentPPO, not of {spec.name}")
+            extra[key] = float(hp[key])
     if n_minibatches is not None:
         if spec.name == "MaskableRecurrentPPO":
             extra["n_minibatches"] = int(n_minibatches)
@@ -165,16 +168,20 @@ def check_run_settings(hp: dict, total) -> None:
         if isinstance(value, bool) or not isinstance(value, int) or value < low:
             raise ValueError(f"{key} must be a whole number >= {low}, got {value!r}")
     for key in ("learning_rate", "clip_range", "gamma", "gae_lambda", "ent_coef", "vf_coef", "max_grad_norm",
-                "ent_coef_message"):
+                *COMMUNICATION_KEYS):
         if key == "learning_rate":
             schedule(hp[key])
-        elif key == "ent_coef_message" and hp.get(key) is None:
-            continue                                    # optional: the message head shares ent_coef
+        elif key in COMMUNICATION_KEYS and hp.get(key) is None:
+            continue                                    # optional, off by default
         elif isinstance(hp.get(key), bool) or not isinstance(hp.get(key), (int, float)):
             raise ValueError(f"{key} must be a number, got {hp.get(key)!r}")
-    if hp.get("ent_coef_message") is not None and get_algorithm(hp.get("algo", DEFAULT_ALGORITHM)).name \
-            != "MaskableRecurrentPPO":
-        raise ValueError(f"ent_coef_message is a setting of MaskableRecurrentPPO, not of {hp.get('algo')}")
+    for key in COMMUNICATION_KEYS:
+        if hp.get(key) is not None and get_algorithm(hp.get("algo", DEFAULT_ALGORITHM)).name \
+                != "MaskableRecurrentPPO":
+            raise ValueError(f"{key} is a setting of MaskableRecurrentPPO, not of {hp.get('algo')}")
+    if hp.get("listen_coef") and (hp.get("env") or {}).get("message_encoding", "scalar") != "planes":
+        raise ValueError("listen_coef needs legible messages: set env.message_encoding=planes (with "
+                         "'scalar' messages the received symbols have no channel of their own)")
 
 
 def normalized_rewards(vec_env, checkpoint: Path | None, gamma: float):
