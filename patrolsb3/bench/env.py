@@ -55,11 +55,15 @@ def pettingzoo_steps_per_s(map_name="A", n_agents=5, n_steps=1000, seed=0) -> fl
 
 
 def run(repeats: int = 5, quick: bool = False) -> dict:
-    """Median figures over ``repeats`` runs (1,024 episodes x 5 agents on map A)."""
+    """Median figures over ``repeats`` runs: the batched core (1,024 episodes x 5 agents on map
+    A) and the PettingZoo env (one episode of 5 agents, and of 3: the issue's figure), learned
+    messages (a simulator step is a message phase and a move phase)."""
     n_envs, n_steps, pz_steps = (64, 20, 100) if quick else (1024, 100, 1000)
     core = [core_steps_per_s(n_envs=n_envs, n_steps=n_steps, seed=r) for r in range(repeats)]
     pz = [pettingzoo_steps_per_s(n_steps=pz_steps, seed=r) for r in range(repeats)]
+    pz3 = [pettingzoo_steps_per_s(n_agents=3, n_steps=pz_steps, seed=r) for r in range(repeats)]
     core_med = statistics.median(core)
     return {"core_env_steps_per_s": round(core_med), "core_agent_steps_per_s": round(core_med * 5),
             "pettingzoo_env_steps_per_s": round(statistics.median(pz)),
+            "pettingzoo_env_steps_per_s_3_agents": round(statistics.median(pz3)),
             "n_envs": n_envs, "n_agents": 5, "map": "A", "repeats": repeats}
