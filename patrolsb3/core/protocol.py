@@ -209,7 +209,7 @@ def next_decision(spec: MapSpec, cfg: EnvConfig, state: State, applied_phase: in
         previous: the decision of ``applied_phase`` (the one those actions answered).
     """
     phase = next_phase(cfg, applied_phase)
-    if applied_phase != MESSAGE_PHASE or phase != MOVE_PHASE:
+    if applied_phase != MESSAGE_PHASE:
         return decide(spec, cfg, state, phase)
     E, A = state.pos.shape
     grid = previous.grid.copy()                                                # (E, A, C, H, W)

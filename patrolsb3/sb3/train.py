@@ -19,17 +19,18 @@ import numpy as np
 from stable_baselines3.common.callbacks import CheckpointCallback
 from stable_baselines3.common.vec_env import VecNormalize
 
+from ..core.config import EnvConfig
 from ..runs import RunFolder, is_valid_model_file, model_steps, write_atomically
 from .algorithms import DEFAULT_ALGORITHM, get_algorithm, torch_device
 from .cpu_time import cpu_hours_of
 from .curriculum import CURRICULUM
 from .hyperparams import load_hyperparams, merge, per_phase, schedule
 
-ALGO_KEYS = ("learning_rate", "n_steps", "n_epochs", "gamma", "gae_lambda", "clip_range", "ent_coef",
-             "vf_coef", "max_grad_norm", "n_minibatches", "batch_size", "policy_kwargs", "target_kl",
-             "ent_coef_message", "signal_coef", "listen_coef")
 COMMUNICATION_KEYS = ("ent_coef_message", "signal_coef", "listen_coef")
 """Optional coefficients of MaskableRecurrentPPO for learned messages (None: off)."""
+ALGO_KEYS = ("learning_rate", "n_steps", "n_epochs", "gamma", "gae_lambda", "clip_range", "ent_coef",
+             "vf_coef", "max_grad_norm", "n_minibatches", "batch_size", "policy_kwargs", "target_kl",
+             *COMMUNICATION_KEYS)
 RUN_KEYS = ("algo", "timesteps", "n_envs", "curriculum", "env", "checkpoint_freq", "eval_freq",
             "eval_episode_steps", "eval_episodes", "torch_threads", "normalize_reward", "mix")
 
@@ -179,7 +180,7 @@ def check_run_settings(hp: dict, total) -> None:
         if hp.get(key) is not None and get_algorithm(hp.get("algo", DEFAULT_ALGORITHM)).name \
                 != "MaskableRecurrentPPO":
             raise ValueError(f"{key} is a setting of MaskableRecurrentPPO, not of {hp.get('algo')}")
-    if hp.get("listen_coef") and (hp.get("env") or {}).get("message_encoding", "scalar") != "planes":
+    if hp.get("listen_coef") and (hp.get("env") or {}).get("message_encoding", EnvConfig.message_encoding) != "planes":
         raise ValueError("listen_coef needs legible messages: set env.message_encoding=planes (with "
                          "'scalar' messages the received symbols have no channel of their own)")
 
