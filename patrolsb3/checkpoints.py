@@ -53,15 +53,22 @@ def validate(path, team_sizes=(1, 3, 5), episodes: int = 4, steps: int = 3000, s
         episode), "bf_rate" (share of episodes with one), "avg_idleness" (AVG^h over every
         episode, failed ones included), "swap_battery" (mean battery fraction at a swap)}.
     """
-    from .evaluate import run_episodes
-    from .zoo import evaluation_config, load_checkpoint
+    from .zoo import load_checkpoint
     policy = load_checkpoint(path)
+    return {"checkpoint": str(path), "timesteps": policy.info["timesteps"],
+            **validate_policy(policy, team_sizes, episodes, steps, seed)}
+
+
+def validate_policy(policy, team_sizes=(1, 3, 5), episodes: int = 4, steps: int = 3000, seed: int = 7) -> dict:
+    """The figures of :func:`validate` for a loaded :class:`~patrolsb3.zoo.ZooPolicy` (a
+    checkpoint or a zoo entry): {"failures", "bf_rate", "avg_idleness", "swap_battery"}."""
+    from .evaluate import run_episodes
+    from .zoo import evaluation_config
     cfg = evaluation_config(policy, steps)
     team = np.repeat(np.asarray(team_sizes, dtype=np.int64), episodes)          # (E,)
     result = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, deterministic=True)
     swap = result["swap_battery"]
-    return {"checkpoint": str(path), "timesteps": policy.info["timesteps"],
-            "failures": float(result["battery_failures"].mean()), "bf_rate": float(result["failed"].mean()),
+    return {"failures": float(result["battery_failures"].mean()), "bf_rate": float(result["failed"].mean()),
             "avg_idleness": float(result["avg_idleness"].mean()),
             "swap_battery": float(np.nanmean(swap)) if np.isfinite(swap).any() else float("nan")}
 

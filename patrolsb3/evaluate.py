@@ -4,7 +4,8 @@ All episodes of one configuration (tests x episodes) step together on the batche
 ``policy.predict(sim_state, memory, episode_start)`` -> actions (E, A, 2), then
 ``core.step(spec, cfg, sim, actions[..., 1], messages=actions[..., 0], compute_reward=False)``
 with ``invalid_action='raise'``. A heuristic (``patrolsb3.strategies``) and a zoo model
-(``zoo:<variant>``, loaded by ``patrolsb3.zoo.load(map, variant)``) are treated the same way.
+(``zoo:<variant>``, loaded by ``patrolsb3.zoo.load(map, variant)``; ``zoo:<variant>:guarded`` for
+the entries behind the return guard) are treated the same way.
 
 Tests: episode e belongs to test ``e // episodes``. Per test, idleness and collision figures
 average over the episodes *without* a battery failure (as in the paper; the count is kept),
@@ -55,28 +56,29 @@ def parse_faults(texts) -> tuple:
 
 def canonical_name(name: str) -> str:
     """The name tables use: heuristics in capitals ('sebs' -> 'SEBS'), zoo models as
-    'zoo:<variant>' in lower case."""
+    'zoo:<variant>' (or 'zoo:<variant>:guarded') in lower case."""
     name = str(name).strip()
     if name.lower().startswith("zoo:"):
-        return "zoo:" + name.split(":", 1)[1].lower()
+        return name.lower()
     return name.upper()
 
 
 def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0, device: str = "cpu"):
     """A heuristic by name, or ``zoo:<variant>`` through ``patrolsb3.zoo.load(map, variant)``
-    (its network on ``device``: auto, cpu or cuda).
+    (``zoo:<variant>:guarded``: the entry behind the return guard; its network on ``device``:
+    auto, cpu or cuda).
 
     Raises:
         ValueError: unknown strategy, or a zoo strategy when no zoo module or model exists.
     """
     if str(name).lower().startswith("zoo:"):
-        variant = str(name).split(":", 1)[1]
         try:
             zoo = importlib.import_module("patrolsb3.zoo")
         except ImportError as exc:
             raise ValueError(f"strategy {name!r} needs patrolsb3.zoo, which cannot be imported: {exc}") from exc
         try:
-            return zoo.load(spec.name, variant, spec=spec, device=device)
+            variant, guard = zoo.parse_strategy(name)
+            return zoo.load(spec.name, variant, spec=spec, device=device, guard=guard)
         except (ValueError, FileNotFoundError) as exc:
             raise ValueError(f"strategy {name!r}: {exc}") from exc
     from . import strategies
@@ -200,7 +202,7 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
     """Evaluate one strategy on one map and team size (the ``patrolsb3 evaluate`` command).
 
     Args:
-        strategy: RANDOM, CR, PART, SEBS, CYCLIC or zoo:<variant>.
+        strategy: RANDOM, CR, PART, SEBS, CYCLIC, zoo:<variant> or zoo:<variant>:guarded.
         map_name: a shipped map name or a map file.
         n_agents: team size.
         episodes: episodes per test.
@@ -287,12 +289,10 @@ def write_zoo_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0
         Path of eval.json: {"map", "strategy", "episodes", "tests", "steps", "seed", "deterministic",
         "results": [evaluate()-style dict per team size]}.
     """
-    from .zoo import evaluation_config, load, read_entry
+    from .zoo import evaluation_config, load_entry, strategy_name
     folder = Path(folder)
-    config = read_entry(folder)["config"]
-    seed_folder = folder.name.startswith("seed") and folder.parent.name == config["variant"]
-    policy = load(config["map"], config["variant"], zoo_dir=folder.parents[2] if seed_folder else folder.parents[1],
-                  seed=int(folder.name[4:]) if seed_folder else None)
+    policy = load_entry(folder)
+    config = policy.info["config"]
     max_agents = policy.cfg.max_agents
     cfg = evaluation_config(policy, steps)
     per_size = episodes * tests
@@ -300,7 +300,7 @@ def write_zoo_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0
     per_episode = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, progress=progress,
                                desc=f"zoo {config['map']}/{config['variant']} n=1..{max_agents}",
                                deterministic=deterministic)
-    strategy = f"zoo:{config['variant']}"
+    strategy = strategy_name(config["variant"], guard=policy.cfg.return_guard)
     results = []
     for n in range(1, max_agents + 1):
         rows = team == n

@@ -24,7 +24,10 @@ PAPER_TABLES = {"BF": "battery_failure_rate", "BLv": "swap_battery_pct", "MAX": 
 PAPER_COLUMNS = ("CR", "PART", "SEBS", "INTENTION", "NOMSG", "MSG")
 EXTRA_COLUMNS = ("RANDOM", "CYCLIC")
 ZOO_COLUMNS = {"INTENTION": "zoo:rl-intention", "NOMSG": "zoo:rl-no-msg", "MSG": "zoo:rl-msg"}
-"""Paper column -> strategy name that fills it."""
+"""Paper column -> strategy name that fills it (the zoo entries in the paper's setting)."""
+GUARDED_COLUMNS = {"INTENTION-GUARDED": "zoo:rl-intention:guarded", "NOMSG-GUARDED": "zoo:rl-no-msg:guarded",
+                   "MSG-GUARDED": "zoo:rl-msg:guarded"}
+"""Extra columns of the entries behind the return guard, present only when a comparison has them."""
 LABELS = {"avg_idleness": "AVG^h", "max_idleness": "MAX^h", "worst_idleness": "worst idleness",
           "std_idleness": "std across vertices", "collisions": "collisions / episode",
           "battery_failures": "battery failures / episode",
@@ -33,7 +36,7 @@ LABELS = {"avg_idleness": "AVG^h", "max_idleness": "MAX^h", "worst_idleness": "w
 
 def column_strategy(column: str) -> str:
     """Strategy name behind a table column (heuristic names are their own)."""
-    return ZOO_COLUMNS.get(column, column)
+    return ZOO_COLUMNS.get(column, GUARDED_COLUMNS.get(column, column))
 
 
 def mean_std(stat: dict, digits: int = 1) -> str:
@@ -157,11 +160,13 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
                 md.append(f"- map {m}, {strategy}: {note}")
             if zoo_notes:
                 md.append("")
+    strategies = {r.get("strategy") for r in results}
+    extra_columns = EXTRA_COLUMNS + tuple(c for c, s in GUARDED_COLUMNS.items() if s in strategies)
     for m in maps:
         for suffix, metric in PAPER_TABLES.items():
             md += [f"## Map {m}: {suffix} ({LABELS[metric]})", ""]
             for columns, name in ((PAPER_COLUMNS, f"{m}-{suffix}.csv"),
-                                  (EXTRA_COLUMNS, f"{m}-{suffix}-extra.csv")):
+                                  (extra_columns, f"{m}-{suffix}-extra.csv")):
                 rows = _table_rows(results, m, metric, columns)
                 path = out / name
                 with path.open("w", newline="") as fh:
@@ -171,10 +176,10 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
                         writer.writerow([row[0]] + ["" if s is None or math.isnan(s["mean"])
                                                     else f"{s['mean']:.6g}" for s in row[1:]])
                 written.append(path)
-            rows_all = _table_rows(results, m, metric, PAPER_COLUMNS + EXTRA_COLUMNS)
+            rows_all = _table_rows(results, m, metric, PAPER_COLUMNS + extra_columns)
             digits = 3 if metric == "battery_failure_rate" else 1
-            md.append("| n | " + " | ".join(PAPER_COLUMNS + EXTRA_COLUMNS) + " |")
-            md.append("|---" * (1 + len(PAPER_COLUMNS + EXTRA_COLUMNS)) + "|")
+            md.append("| n | " + " | ".join(PAPER_COLUMNS + extra_columns) + " |")
+            md.append("|---" * (1 + len(PAPER_COLUMNS + extra_columns)) + "|")
             for row in rows_all:
                 cells = _best_marked([mean_std(s, digits) for s in row[1:]], row[1:], metric)
                 md.append(f"| {row[0]} | " + " | ".join(cells) + " |")

@@ -1,4 +1,14 @@
-"""The model zoo: trained checkpoints in ``zoo/<map>/<variant>/``, loadable in one line.
+"""The model zoo: trained checkpoints, loadable in one line.
+
+Two settings, two folders (the rule lives here, in :func:`entry_dir`):
+
+- the **paper's setting** (the default): ``zoo/<MAP>/<variant>/seed<k>/``, one folder per
+  training seed, trained and evaluated with no return guard; ``zoo/<MAP>/<variant>/default.yml``
+  names the seed chosen by validation (``patrolsb3 zoo choose``, on the validation seed, never
+  the evaluation's). With a single seed and no ``default.yml``, that seed is the default.
+- **behind the return guard** (``guard=True``, strategy ``zoo:<variant>:guarded``):
+  ``zoo/guarded/<MAP>/<variant>/``, the earlier entries that act with the heuristics' recharge
+  rule as a shield (``env.return_guard``, ours; not the paper's setting).
 
 Each entry folder holds ``model.zip`` (policy only, no optimizer state), ``config.yml`` (env
 config, algorithm, hyperparameters, versions, training budget), ``command.txt``,
@@ -58,19 +68,114 @@ def zoo_root(zoo_dir=None) -> Path:
 
 
 VARIANT_NAMES = ("rl-msg", "rl-no-msg", "rl-intention")
+GUARDED = "guarded"
+"""Subfolder of the zoo holding the entries behind the return guard, and the strategy-name suffix
+that selects them (``zoo:rl-msg:guarded``)."""
+DEFAULT_FILE = "default.yml"
+"""In a paper-setting entry folder: ``{seed: k, chosen_by: ...}``, the seed ``load`` uses by default."""
 
 
-def entry_dir(map_name: str, variant: str, zoo_dir=None, seed: int | None = None) -> Path:
-    """Folder of one zoo entry (it need not exist): ``<zoo>/<MAP>/<variant>``, the default (the
-    seed chosen by validation), or its ``seed<k>`` subfolder for one training seed."""
-    folder = zoo_root(zoo_dir) / str(map_name).upper() / variant
-    return folder if seed is None else folder / f"seed{int(seed)}"
+def parse_strategy(name: str) -> tuple[str, bool]:
+    """``"zoo:rl-msg"`` -> ``("rl-msg", False)``; ``"zoo:rl-msg:guarded"`` -> ``("rl-msg", True)``.
+
+    Raises:
+        ZooError: not a zoo strategy, an unknown variant or an unknown suffix.
+    """
+    parts = str(name).strip().split(":")
+    if parts[0].lower() != "zoo" or len(parts) not in (2, 3):
+        raise ZooError(f"{name!r} is not a zoo strategy; expected zoo:<variant> or zoo:<variant>:{GUARDED}")
+    variant = parts[1].lower()
+    if variant not in VARIANT_NAMES:
+        raise ZooError(f"{name!r}: unknown variant {variant!r}; known: {', '.join(VARIANT_NAMES)}")
+    if len(parts) == 3 and parts[2].lower() != GUARDED:
+        raise ZooError(f"{name!r}: unknown suffix {parts[2]!r}; the only one is :{GUARDED} (the entries "
+                       f"behind the return guard)")
+    return variant, len(parts) == 3
 
 
-def seeds(map_name: str, variant: str, zoo_dir=None) -> list[int]:
-    """The training seeds an entry holds besides its default (``seed<k>`` subfolders)."""
-    folder = entry_dir(map_name, variant, zoo_dir)
+def strategy_name(variant: str, guard: bool = False) -> str:
+    """The strategy name of an entry: ``zoo:<variant>``, or ``zoo:<variant>:guarded``."""
+    return f"zoo:{variant}" + (f":{GUARDED}" if guard else "")
+
+
+def variant_folder(map_name: str, variant: str, zoo_dir=None, guard: bool = False) -> Path:
+    """``<zoo>/<MAP>/<variant>`` (paper's setting) or ``<zoo>/guarded/<MAP>/<variant>``; it need not exist."""
+    root = zoo_root(zoo_dir)
+    return (root / GUARDED if guard else root) / str(map_name).upper() / variant
+
+
+def seeds(map_name: str, variant: str, zoo_dir=None, guard: bool = False) -> list[int]:
+    """The training seeds an entry holds (its ``seed<k>`` subfolders with a model)."""
+    folder = variant_folder(map_name, variant, zoo_dir, guard)
     return sorted(int(p.parent.name[4:]) for p in folder.glob("seed*/model.zip") if p.parent.name[4:].isdigit())
+
+
+def default_seed(map_name: str, variant: str, zoo_dir=None) -> dict | None:
+    """The paper-setting entry's default seed: ``{"seed": k, "chosen_by": text}`` from its
+    ``default.yml``, else its only seed; None when it has no seed.
+
+    Raises:
+        ZooError: several seeds and no ``default.yml`` (say how to choose), or a default.yml
+            naming a seed the entry lacks.
+    """
+    folder = variant_folder(map_name, variant, zoo_dir)
+    have = seeds(map_name, variant, zoo_dir)
+    if (folder / DEFAULT_FILE).is_file():
+        chosen = yaml.safe_load((folder / DEFAULT_FILE).read_text()) or {}
+        if chosen.get("seed") not in have:
+            raise ZooError(f"{folder / DEFAULT_FILE}: names seed {chosen.get('seed')!r}, the entry has {have}")
+        return chosen
+    if len(have) > 1:
+        raise ZooError(f"{folder}: seeds {have} and no {DEFAULT_FILE}; run 'patrolsb3 zoo choose "
+                       f"{str(map_name).upper()} {variant}' to pick one by validation")
+    return {"seed": have[0], "chosen_by": "the only seed"} if have else None
+
+
+def choose_default(map_name: str, variant: str, zoo_dir=None, team_sizes=(1, 3, 5), episodes: int = 4,
+                   steps: int = 3000, seed: int = 7) -> dict:
+    """Pick the paper-setting entry's default seed by validation and write its ``default.yml``.
+
+    Each seed's model plays the greedy validation protocol of ``zoo validate`` (its own
+    simulator seed, not the evaluation's 0, so the choice does not peek at the reported
+    figures); the best by :func:`patrolsb3.checkpoints.rank` (fewest battery failures, then
+    the lowest AVG^h) becomes the default.
+
+    Returns:
+        What was written: {"seed", "chosen_by", "validation": [one row per seed]}.
+
+    Raises:
+        ZooError: the entry has no seed.
+    """
+    from .checkpoints import rank, validate_policy
+    folder = variant_folder(map_name, variant, zoo_dir)
+    have = seeds(map_name, variant, zoo_dir)
+    if not have:
+        raise ZooError(f"{folder}: no seed<k>/model.zip to choose from")
+    rows = [{"seed": k, **validate_policy(load_entry(folder / f"seed{k}"), team_sizes, episodes, steps, seed)}
+            for k in have]
+    best = rank(rows)[0]
+    chosen = {"seed": best["seed"],
+              "chosen_by": (f"zoo choose: greedy validation (simulator seed {seed}, {episodes} episodes x "
+                            f"{steps} steps for n = {','.join(map(str, team_sizes))}): fewest battery "
+                            f"failures, then the lowest AVG^h"),
+              "validation": [{k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()} for r in rows]}
+    text = yaml.safe_dump(chosen, sort_keys=False)
+    write_atomically(folder / DEFAULT_FILE, lambda partial: partial.write_text(text))
+    return chosen
+
+
+def entry_dir(map_name: str, variant: str, zoo_dir=None, seed: int | None = None, guard: bool = False) -> Path:
+    """Folder of one zoo entry (it need not exist).
+
+    Paper's setting: ``<zoo>/<MAP>/<variant>/seed<k>``, ``seed`` or else the default seed
+    (:func:`default_seed`; the bare variant folder when there is none). Behind the guard:
+    ``<zoo>/guarded/<MAP>/<variant>``, or its ``seed<k>`` subfolder.
+    """
+    folder = variant_folder(map_name, variant, zoo_dir, guard)
+    if seed is None and not guard:
+        chosen = default_seed(map_name, variant, zoo_dir)
+        seed = chosen["seed"] if chosen else None
+    return folder if seed is None else folder / f"seed{int(seed)}"
 
 
 def read_entry(path: Path) -> dict:
@@ -87,15 +192,26 @@ def read_entry(path: Path) -> dict:
 
 
 def list_entries(zoo_dir=None) -> list[dict]:
-    """Every entry of the zoo (maps A..D x variants), sorted by map then variant."""
+    """Every entry folder of the zoo, the paper's setting (every seed) first, then the guarded
+    ones; sorted by map, variant and seed. Each dict also has ``guard`` (bool) and ``seed``
+    (the folder's training seed, None for a guarded entry's default folder)."""
     root = zoo_root(zoo_dir)
-    return [read_entry(p.parent) for p in sorted(root.glob("*/*/config.yml"))]
+    found = []
+    for guard, pattern in ((False, "[A-Z]*/*/seed*/config.yml"),
+                           (True, f"{GUARDED}/*/*/config.yml"), (True, f"{GUARDED}/*/*/seed*/config.yml")):
+        for path in sorted(root.glob(pattern)):
+            entry = read_entry(path.parent)
+            name = path.parent.name
+            entry["guard"] = guard
+            entry["seed"] = int(name[4:]) if name.startswith("seed") and name[4:].isdigit() else None
+            found.append(entry)
+    return found
 
 
-def available(map_name: str, variant: str, zoo_dir=None) -> bool:
-    """True when the zoo has a model for (map, variant); False also when there is no zoo."""
+def available(map_name: str, variant: str, zoo_dir=None, guard: bool = False) -> bool:
+    """True when the zoo has a model for (map, variant) in that setting; False also when there is no zoo."""
     try:
-        return (entry_dir(map_name, variant, zoo_dir) / "model.zip").is_file()
+        return (entry_dir(map_name, variant, zoo_dir, guard=guard) / "model.zip").is_file()
     except ZooError:
         return False
 
@@ -298,7 +414,7 @@ def load_checkpoint(path, spec=None) -> ZooPolicy:
 
 
 def load(map_name: str, variant: str, zoo_dir=None, spec=None, device: str = "cpu",
-         seed: int | None = None) -> ZooPolicy:
+         seed: int | None = None, guard: bool = False) -> ZooPolicy:
     """Load a zoo model ready to act: ``patrolsb3.zoo.load("A", "rl-msg")``.
 
     Args:
@@ -307,39 +423,74 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None, device: str = "cp
         zoo_dir: another zoo folder (default: the repository's ``zoo/``).
         spec: the map to act on (default: ``map_name``); must match the training map's size.
         device: where the network runs: "cpu" (default), "cuda" or "auto".
-        seed: one training seed's model (``zoo/<MAP>/<variant>/seed<k>``); None: the entry's
-            default, the seed chosen by validation.
+        seed: one training seed's model (``seed<k>``); None: the entry's default, the seed
+            chosen by validation (:func:`default_seed`).
+        guard: the entry trained and acting behind the return guard (``zoo/guarded/``, not the
+            paper's setting) instead of the paper's setting.
 
     Raises:
         ZooError: no such entry or seed (lists what the zoo has), or a checkpoint trained for
             another env version or map size.
         ValueError: a device torch cannot use.
     """
+    folder = existing_entry_dir(map_name, variant, zoo_dir, seed, guard)
+    return load_entry(folder, spec=spec if spec is not None else map_name, device=device)
+
+
+def existing_entry_dir(map_name: str, variant: str, zoo_dir=None, seed: int | None = None,
+                       guard: bool = False) -> Path:
+    """:func:`entry_dir`, checked: the folder holds a model.
+
+    Raises:
+        ZooError: an unknown variant, or no such entry or seed (the message lists what the zoo has).
+    """
     if variant not in VARIANT_NAMES:
         raise ZooError(f"unknown variant {variant!r}; known: {', '.join(VARIANT_NAMES)}")
-    folder = entry_dir(map_name, variant, zoo_dir, seed)
+    setting = "behind the return guard" if guard else "in the paper's setting"
+    folder = entry_dir(map_name, variant, zoo_dir, seed, guard)
     if seed is not None and not (folder / "model.zip").is_file():
-        raise ZooError(f"no seed {seed} of {str(map_name).upper()}/{variant} (looked for {folder / 'model.zip'}); "
-                       f"its seeds: {seeds(map_name, variant, zoo_dir) or 'none besides the default'}")
+        raise ZooError(f"no seed {seed} of {str(map_name).upper()}/{variant} {setting} (looked for "
+                       f"{folder / 'model.zip'}); its seeds: {seeds(map_name, variant, zoo_dir, guard) or 'none'}")
     if not (folder / "model.zip").is_file():
-        have = [f"{Path(e['path']).parent.name}/{Path(e['path']).name}" for e in list_entries(zoo_dir)]
-        raise ZooError(f"no zoo model for map {str(map_name).upper()} variant {variant} "
+        have = sorted({f"{str(e['config'].get('map', '?')).upper()}/{e['config'].get('variant', '?')}"
+                       + (f":{GUARDED}" if e["guard"] else "") for e in list_entries(zoo_dir)})
+        raise ZooError(f"no zoo model for map {str(map_name).upper()} variant {variant} {setting} "
                        f"(looked for {folder / 'model.zip'}); the zoo has: {', '.join(have) or 'nothing'}")
+    return folder
+
+
+def load_entry(folder, spec=None, device: str = "cpu") -> ZooPolicy:
+    """The policy of one entry folder (``model.zip`` + ``config.yml``), like :func:`load`.
+
+    Args:
+        folder: an entry folder, e.g. ``zoo/A/rl-msg/seed0``.
+        spec: the map to act on (default: the training map file if it is still there, else
+            the map by name); must match its size.
+        device: "cpu" (default), "cuda" or "auto".
+
+    Raises:
+        ZooError: no model or config, a checkpoint of another env version, observation layout
+            or map size, or a file that cannot be loaded.
+    """
+    folder = Path(folder)
     info = read_entry(folder)
     config = info["config"]
     version = config.get("env_version")
     if version != ENV_VERSION:
         raise ZooError(f"{folder}: trained for env version {version!r}, this code is {ENV_VERSION!r}; "
                        f"retrain it or use a matching patrolsb3 release")
-    spec = checked_map(config, spec if spec is not None else map_name, folder)
+    if spec is None:   # the training map file if it is still there, else the map by name
+        source = config.get("map_source")
+        spec = source if source and Path(source).is_file() else config["map"]
+    spec = checked_map(config, spec, folder)
     cfg = env_config(config)
     import torch
     torch.set_num_threads(1)     # small networks: one thread is fastest, and several oversubscribe
     from .sb3.algorithms import get_algorithm, torch_device
     _, policy_class = get_algorithm(config.get("algo", "MaskableRecurrentPPO")).classes()
     if not zip_is_intact(folder / "model.zip"):
-        raise ZooError(f"{folder / 'model.zip'}: the file is empty, cut or corrupt (its zip check fails); "
-                       f"restore it from git")
+        raise ZooError(f"{folder / 'model.zip'}: the file is missing, empty, cut or corrupt (its zip check "
+                       f"fails); restore it from git")
     try:
         policy = policy_class.load(str(folder / "model.zip"), device=torch_device(device))
     except Exception as exc:  # a corrupt or foreign file: say which one
@@ -365,11 +516,13 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
         budget: extra facts about the training budget, stored in config.yml. Without
             ``cpu_hours`` in it, the CPU hours the run measured (``cpu_time.csv``, its
             warm-start stages included) are recorded, when every stage measured them.
-        as_seed: write into the entry's ``seed<k>`` subfolder (k: the run's training seed)
-            instead of its default folder; ``load(map, variant, seed=k)`` reads it.
+        as_seed: for a run behind the return guard, write into the guarded entry's ``seed<k>``
+            subfolder (k: the run's training seed) instead of its default folder. A run in the
+            paper's setting always goes to ``zoo/<MAP>/<variant>/seed<k>/``.
 
     Returns:
-        The entry folder ``zoo/<map>/<variant>/`` (or its ``seed<k>``).
+        The entry folder: ``zoo/<MAP>/<variant>/seed<k>`` for a run in the paper's setting (no
+        return guard), ``zoo/guarded/<MAP>/<variant>`` (or its ``seed<k>``) for a guarded one.
 
     Raises:
         ZooError: the run folder lacks a model or a config.
@@ -389,7 +542,9 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
     from .sb3.algorithms import get_algorithm
     algo_class, _ = get_algorithm(config["algo"]).classes()
     model = algo_class.load(str(source), device="cpu")
-    folder = entry_dir(config["map"], config["variant"], zoo_dir, seed=config.get("seed", 0) if as_seed else None)
+    guard = bool((config.get("env") or {}).get("return_guard"))
+    folder = entry_dir(config["map"], config["variant"], zoo_dir, guard=guard,
+                       seed=config.get("seed", 0) if as_seed or not guard else None)
     folder.mkdir(parents=True, exist_ok=True)
     write_atomically(folder / "model.zip", lambda partial: model.policy.save(str(partial)))
     for name in (run.COMMAND, *run.RECORDS):
@@ -416,9 +571,9 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
 
 
 def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, steps: int, seed: int,
-                  tests: int = 1, zoo_dir=None, deterministic: bool = True):
-    """The entry's eval.json result for exactly this protocol and action mode, or None."""
-    path = entry_dir(map_name, variant, zoo_dir) / "eval.json"
+                  tests: int = 1, zoo_dir=None, deterministic: bool = True, guard: bool = False):
+    """The default entry's eval.json result for exactly this protocol and action mode, or None."""
+    path = entry_dir(map_name, variant, zoo_dir, guard=guard) / "eval.json"
     if not path.is_file():
         return None
     data = json.loads(path.read_text())
@@ -426,4 +581,5 @@ def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
     if (data.get("episodes"), data.get("steps"), data.get("seed"), data.get("tests"),
             data.get("deterministic", True)) != (episodes, steps, seed, tests, deterministic):
         return None
-    return next((r for r in data.get("results", []) if r["n_agents"] == n_agents), None)
+    found = next((r for r in data.get("results", []) if r["n_agents"] == n_agents), None)
+    return None if found is None else {**found, "strategy": strategy_name(variant, guard)}

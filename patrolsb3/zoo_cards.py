@@ -23,11 +23,28 @@ def simulator_steps(config: dict, agent_steps: int) -> int:
     return int(agent_steps) // (rows * phases) * int((config.get("hyperparams") or {}).get("n_envs", 8))
 
 
+def entry_name(entry: dict) -> str:
+    """``A/rl-msg/seed0`` (paper's setting), ``guarded/A/rl-msg`` (behind the return guard)."""
+    c = entry["config"]
+    name = f"{c.get('map')}/{c.get('variant')}" + (f"/seed{entry['seed']}" if entry.get("seed") is not None else "")
+    return f"guarded/{name}" if entry.get("guard") else name
+
+
+def load_line(entry: dict) -> str:
+    """The line of Python that loads this entry, and its strategy name."""
+    from .zoo import strategy_name
+    c = entry["config"]
+    extra = (", guard=True" if entry.get("guard") else "") + \
+        (f", seed={entry['seed']}" if entry.get("seed") is not None else "")
+    return (f"policy = zoo.load({c.get('map')!r}, {c.get('variant')!r}{extra})        # evaluation: "
+            f"--strategy {strategy_name(c.get('variant'), bool(entry.get('guard')))}")
+
+
 def card(entry: dict) -> str:
-    """The markdown card of one entry (``patrolsb3.zoo.read_entry``'s dict)."""
+    """The markdown card of one entry (``patrolsb3.zoo.list_entries``' dict)."""
     c, ev = entry["config"], entry.get("eval") or {}
     env, budget = c.get("env") or {}, c.get("budget") or {}
-    name = f"{c.get('map')}/{c.get('variant')}"
+    name = entry_name(entry)
     guarded = bool(env.get("return_guard"))
     lines = [f"# {name}", "",
              f"- **variant**: `{c.get('variant')}`, {VARIANT_TEXT.get(c.get('variant'), '')}",
@@ -41,7 +58,8 @@ def card(entry: dict) -> str:
              f"- **budget**: {int(budget.get('timesteps', 0)):,} agent-steps (all stages), about "
              f"{simulator_steps(c, budget.get('timesteps', 0)):,} simulator steps of episodes, "
              f"{budget.get('cpu_hours', '?')} CPU hours; {PAPER_BUDGET}",
-             f"- **seeds**: one (training seed {c.get('seed')}); no spread over seeds yet", ""]
+             f"- **training seed**: {c.get('seed')} (each seed is its own entry; the tables of "
+             f"zoo/README.md pool them)", ""]
     if ev:
         lines += ["## Evaluation", "",
                   f"{ev.get('tests')} test x {ev.get('episodes')} episodes x {ev.get('steps')} steps per "
@@ -61,7 +79,7 @@ def card(entry: dict) -> str:
         lines.append("")
     lines += ["## How to load it", "", "```python", "import patrolsb3",
               "from patrolsb3 import zoo", "from patrolsb3.agents import PettingZooAgent, play_episode", "",
-              f"policy = zoo.load({c.get('map')!r}, {c.get('variant')!r})        # evaluation: --strategy zoo:{c.get('variant')}",
+              load_line(entry),
               f"env = patrolsb3.parallel_env({c.get('map')!r}, n_agents=3, **policy.env_settings())",
               "print(play_episode(env, PettingZooAgent(policy, env), seed=0))", "```", ""]
     return "\n".join(lines)
@@ -76,13 +94,13 @@ def write_cards(out_dir, zoo_dir=None) -> list[Path]:
                           "|---|---|---|---|---|"]
     for entry in list_entries(zoo_dir):
         c = entry["config"]
-        stem = f"{c.get('map')}-{c.get('variant')}"
+        stem = entry_name(entry).replace("/", "-")
         path = out / f"{stem}.md"
         path.write_text(card(entry))
         written.append(path)
         guarded = "return guard" if (c.get("env") or {}).get("return_guard") else "paper's"
         budget = c.get("budget") or {}
-        index.append(f"| [{c.get('map')}/{c.get('variant')}]({stem}.md) | {c.get('variant')} | {guarded} | "
+        index.append(f"| [{entry_name(entry)}]({stem}.md) | {c.get('variant')} | {guarded} | "
                      f"{int(budget.get('timesteps', 0)):,} | {budget.get('cpu_hours', '?')} |")
     (out / "index.md").write_text("\n".join(index) + "\n")
     return written + [out / "index.md"]

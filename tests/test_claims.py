@@ -103,6 +103,20 @@ def test_the_command_on_a_comparison_and_its_refusals(tmp_path, capsys):
     assert "not an 'evaluate --json' result" in capsys.readouterr().err
 
 
+def test_claims_on_the_guarded_entries_only_when_asked(tmp_path, capsys):
+    from patrolsb3 import zoo
+    if not zoo.available("A", "rl-msg", guard=True):
+        pytest.skip("needs the zoo's guarded A/rl-msg")
+    assert cli.main(["compare", "--maps", "A", "--agents", "1", "--strategies", "CR,SEBS,zoo:rl-msg:guarded",
+                     "--episodes", "1", "--steps", "40", "--no-progress", "--rerun-zoo", "--out", str(tmp_path / "g")]) == 0
+    capsys.readouterr()
+    first_row = lambda text: next(line for line in text.splitlines() if "lowest MAX^h on every map" in line)
+    assert cli.main(["claims", str(tmp_path / "g")]) == 0
+    assert "not measured" in first_row(capsys.readouterr().out)      # the shield does not stand for RL-MSG
+    assert cli.main(["claims", str(tmp_path / "g"), "--guarded"]) == 0
+    assert "not measured" not in first_row(capsys.readouterr().out)  # asked for: it does
+
+
 @pytest.mark.parametrize("sizes", [[1]])
 def test_lowest_restricted_to_sizes(sizes):
     figures = {("A", 1, "me", "x"): fig(1), ("A", 1, "you", "x"): fig(5), ("A", 3, "me", "x"): fig(9),

@@ -129,6 +129,21 @@ def test_cli_compare_stochastic_samples_the_zoo_model(tmp_path):
     assert greedy[0]["deterministic"] == "True" and sampled[0]["deterministic"] == "False"
 
 
+@pytest.mark.skipif(not zoo.available("A", "rl-msg", guard=True), reason="needs the zoo's guarded A/rl-msg")
+def test_compare_shows_the_guarded_entries_only_when_asked_and_labelled(tmp_path, capsys):
+    assert cli.main(["compare", "--maps", "A", "--agents", "1", "--episodes", "1", "--steps", "30",
+                     "--strategies", "CR,zoo:rl-msg:guarded", "--out", str(tmp_path / "g"), "--no-progress"]) == 0
+    extra = list(csv.reader((tmp_path / "g" / "A-MAX-extra.csv").open()))
+    assert extra[0] == ["n", "RANDOM", "CYCLIC", "MSG-GUARDED"] and extra[1][3] != ""
+    main = list(csv.reader((tmp_path / "g" / "A-MAX.csv").open()))
+    assert main[1][main[0].index("MSG")] == ""                   # the shield never fills the paper's column
+    report = (tmp_path / "g" / "report.md").read_text()
+    assert "map A, zoo:rl-msg:guarded: behind the return guard" in report and "| MSG-GUARDED |" in report
+    assert cli.main(["compare", "--maps", "A", "--agents", "1", "--episodes", "1", "--steps", "5",
+                     "--strategies", "zoo:rl-msg:shielded", "--out", str(tmp_path / "bad")]) == 2
+    assert "unknown suffix 'shielded'" in capsys.readouterr().err and not (tmp_path / "bad").exists()
+
+
 def test_faults_outside_the_episode_are_refused():
     with pytest.raises(ValueError, match="outside the episode"):
         evaluate("CR", "A", 2, episodes=1, steps=100, faults=((100, 1),), progress=False)

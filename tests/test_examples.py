@@ -44,4 +44,5 @@ def test_compare_map_a_example_writes_the_report(tmp_path):
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert (tmp_path / "cmp" / "report.md").is_file() and (tmp_path / "cmp" / "A.png").is_file()
     report = (tmp_path / "cmp" / "report.md").read_text()
-    assert "map A, zoo:rl-msg: behind the return guard" in report and "computed now" in report
+    assert "map A, zoo:rl-msg: the paper's setting (no return guard); training seed 0" in report
+    assert "computed now" in report and "behind the return guard" not in report

@@ -163,10 +163,8 @@ def test_n_minibatches_splits_the_deployed_rows():
 def test_a_zoo_model_zip_loads_as_an_sb3_model_and_acts_on_the_training_env():
     """SB3 users' way: MaskableRecurrentPPO.load(zoo model.zip) (a policy only), predict with
     action_masks on the training vec env's rows; with env= it trains on."""
-    from pathlib import Path
-
     from patrolsb3 import zoo
-    entry = Path(__file__).resolve().parent.parent / "zoo" / "A" / "rl-msg" / "model.zip"
+    entry = zoo.entry_dir("A", "rl-msg") / "model.zip"         # zoo/A/rl-msg/seed<k>/, the paper's setting
     model = MaskableRecurrentPPO.load(entry, device="cpu")
     policy = zoo.load("A", "rl-msg")
     settings = {k: v for k, v in policy.env_settings().items() if k != "comm"}
@@ -303,3 +301,50 @@ def test_listening_and_signalling_settings_are_refused_where_they_mean_nothing()
     hp = resolve_hyperparams("A", overrides={"algo": "MaskablePPO", "signal_coef": 0.1})
     with pytest.raises(ValueError, match="signal_coef is a setting of MaskableRecurrentPPO"):
         check_run_settings(hp, 1000)
+    hp = resolve_hyperparams("A", overrides={"message_team_share": 2})
+    with pytest.raises(ValueError, match="message_team_share must be between 0 and 1"):
+        check_run_settings(hp, 1000)
+
+
+def test_team_gap_is_the_team_mean_minus_the_own_reward_of_deployed_rows():
+    from patrolsb3.sb3.buffers import team_gap
+    rewards = np.array([1.0, 3.0, 9.0, 4.0, 0.0, 7.0])            # two episodes of 3 slots
+    deployed = np.array([True, True, False, True, True, True])     # episode 0 deploys 2 slots
+    gaps = team_gap(rewards, deployed, np.array([0, 0, 0, 1, 1, 1]))
+    np.testing.assert_allclose(gaps, [1.0, -1.0, 0.0, 11 / 3 - 4, 11 / 3, 11 / 3 - 7])   # means 2 and 11/3
+
+
+def test_message_team_share_moves_only_the_message_rows_advantages_by_the_discounted_team_gap():
+    """Two identical runs, one with message_team_share=1: same rollout, same returns (the
+    critic's targets), same advantages on move rows; on rows with a message choice the
+    advantage grows by the GAE (values 0) of the team-mean-minus-own rewards, computed here
+    with the textbook recursion."""
+    def model(share):
+        env = make_vec_env(parse_map(NON_SQUARE, name="ns"), agents=(2, 3, 3), variant="rl-msg", seed=0,
+                           max_agents=3, episode_steps=6)
+        return MaskableRecurrentPPO(PatrolRecurrentPolicy, env, n_steps=16, batch_size=50, n_epochs=1, seed=0,
+                                    device="cpu", gamma=0.95, gae_lambda=0.9, message_team_share=share,
+                                    policy_kwargs=policy_kwargs_for(env.layout, dense_sizes=(32, 32),
+                                                                    lstm_hidden_size=16))
+    plain = collect(model(None))          # each model seeds torch when built: build, then collect
+    with_share = model(1.0)
+    shared = collect(with_share)
+    last_dones = np.asarray(with_share._last_episode_starts, dtype=np.float64)     # (9,) ended at the last step
+    np.testing.assert_array_equal(plain.actions, shared.actions)
+    np.testing.assert_allclose(plain.returns, shared.returns)
+    gaps = shared.team_gaps.astype(np.float64)                                  # (16, 9)
+    assert np.allclose(gaps.reshape(16, 3, 3).sum(axis=-1)[:, 0] + gaps[:, 2], 0.0, atol=1e-5)   # 2 deployed
+    assert (gaps[:, 2] == 0).all() and np.abs(gaps).max() > 0                   # padded slot: 0
+    expected = np.zeros_like(gaps)
+    following = np.zeros(9)
+    for t in reversed(range(16)):
+        non_terminal = 1.0 - (shared.episode_starts[t + 1] if t < 15 else last_dones)
+        following = gaps[t] + 0.95 * 0.9 * non_terminal * following
+        expected[t] = following
+    speaking = shared.action_masks[..., :16].sum(axis=-1) > 1
+    assert speaking.any() and (~speaking).any()
+    np.testing.assert_allclose(shared.advantages[~speaking], plain.advantages[~speaking], atol=1e-6)
+    np.testing.assert_allclose(shared.advantages[speaking] - plain.advantages[speaking], expected[speaking],
+                               atol=1e-4)
+    with pytest.raises(ValueError, match="message_team_share must be between 0 and 1"):
+        model(1.5)

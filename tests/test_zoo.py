@@ -35,7 +35,7 @@ def trained(tmp_path_factory):
 
 def test_export_keeps_the_policy_only_and_records_the_budget(trained):
     folder = trained["folder"]
-    assert folder == trained["root"] / "zoo" / "ROOM" / "rl-msg"
+    assert folder == trained["root"] / "zoo" / "ROOM" / "rl-msg" / "seed0"   # paper's setting: one folder a seed
     names = zipfile.ZipFile(folder / "model.zip").namelist()
     assert not any("optimizer" in n for n in names)
     run_names = zipfile.ZipFile(trained["run"] / "model.zip").namelist()
@@ -108,9 +108,7 @@ def test_zoo_policy_runs_strict_episodes_and_writes_eval(trained):
     assert np.all(result["avg_idleness"] > 0)
 
 
-def test_write_eval_on_every_team_size(trained, monkeypatch):
-    monkeypatch.setattr(zoo, "load", lambda m, v, zoo_dir=None, spec=None, seed=None, _load=zoo.load:
-                        _load(m, v, zoo_dir=zoo_dir, spec=trained["map_file"], seed=seed))
+def test_write_eval_on_every_team_size(trained):
     from patrolsb3.evaluate import write_zoo_eval
     path = write_zoo_eval(trained["folder"], episodes=2, steps=30, progress=False)
     data = json.loads(path.read_text())
@@ -151,7 +149,7 @@ def test_refusals_name_the_problem(trained, tmp_path):
     with pytest.raises(zoo.ZooError, match=r"trained on a \(4, 6\) map"):
         zoo.load("ROOM", "rl-msg", zoo_dir=zoo_dir, spec="A")
     # another env version
-    other = tmp_path / "zoo" / "ROOM" / "rl-msg"
+    other = tmp_path / "zoo" / "ROOM" / "rl-msg" / "seed0"
     other.mkdir(parents=True)
     for name in ("model.zip", "config.yml"):
         (other / name).write_bytes((trained["folder"] / name).read_bytes())
@@ -187,7 +185,7 @@ def test_the_local_idleness_layout_travels_with_the_checkpoint(trained, tmp_path
     actions, _ = policy.predict(sim, state=None, episode_start=np.ones(2, bool))
     assert actions.shape == (2, 5, 2)
     # the same weights under a config without it are refused, naming the layout
-    path = tmp_path / "zoo" / "ROOM" / "rl-msg" / "config.yml"
+    path = tmp_path / "zoo" / "ROOM" / "rl-msg" / "seed0" / "config.yml"
     config = yaml.safe_load(path.read_text())
     config["env"]["local_idleness"] = False
     path.write_text(yaml.safe_dump(config))
@@ -215,13 +213,15 @@ def test_zoo_list_prints_budget_and_headline_figures(trained, capsys):
 def test_a_model_trained_behind_the_return_guard_acts_behind_it(trained, tmp_path, capsys):
     import shutil
     from patrolsb3.core.masks import action_mask, return_threshold
-    shutil.copytree(trained["folder"], tmp_path / "zoo" / "ROOM" / "rl-msg")
-    path = tmp_path / "zoo" / "ROOM" / "rl-msg" / "config.yml"
+    shutil.copytree(trained["folder"], tmp_path / "zoo" / "guarded" / "ROOM" / "rl-msg")
+    path = tmp_path / "zoo" / "guarded" / "ROOM" / "rl-msg" / "config.yml"
     config = yaml.safe_load(path.read_text())
     config["env"]["return_guard"] = True
     path.write_text(yaml.safe_dump(config))
-    guarded = zoo.load("ROOM", "rl-msg", zoo_dir=tmp_path / "zoo", spec=trained["map_file"])
-    plain = zoo.load("ROOM", "rl-msg", zoo_dir=trained["folder"].parent.parent, spec=trained["map_file"])
+    with pytest.raises(zoo.ZooError, match="in the paper's setting .*the zoo has: ROOM/rl-msg:guarded"):
+        zoo.load("ROOM", "rl-msg", zoo_dir=tmp_path / "zoo", spec=trained["map_file"])   # the default is not the shield
+    guarded = zoo.load("ROOM", "rl-msg", zoo_dir=tmp_path / "zoo", spec=trained["map_file"], guard=True)
+    plain = zoo.load("ROOM", "rl-msg", zoo_dir=trained["root"] / "zoo", spec=trained["map_file"])
     assert guarded.cfg.return_guard and not plain.cfg.return_guard
     spec = load_map(trained["map_file"])
     cfg = make_config(None, episode_steps=50)
@@ -248,7 +248,7 @@ def test_corrupt_files_and_configs_are_refused_in_one_line(trained, tmp_path):
     from patrolsb3.core import MapError, load_map
     copy = tmp_path / "zoo"
     shutil.copytree(trained["root"] / "zoo", copy)
-    (entry,) = [p.parent for p in copy.glob("*/*/model.zip")]
+    (entry,) = [p.parent for p in copy.glob("*/*/seed*/model.zip")]
     model = entry / "model.zip"
     data = bytearray(model.read_bytes())
     data[len(data) // 2] ^= 0xFF                      # flipped bytes: the CRC check fails
@@ -273,18 +273,47 @@ def test_corrupt_files_and_configs_are_refused_in_one_line(trained, tmp_path):
         load_map(binary)
 
 
-def test_seeds_of_an_entry_load_by_seed(trained, tmp_path):
+def test_seeds_of_an_entry_and_the_default_chosen_by_validation(trained, tmp_path, capsys):
     import shutil
+
+    from patrolsb3.cli import main
     copy = tmp_path / "zoo"
     shutil.copytree(trained["root"] / "zoo", copy)
-    folder = zoo.export(trained["run"], zoo_dir=copy, as_seed=True)
-    assert folder == copy / "ROOM" / "rl-msg" / "seed0"
     assert zoo.seeds("ROOM", "rl-msg", zoo_dir=copy) == [0]
+    assert zoo.default_seed("ROOM", "rl-msg", zoo_dir=copy) == {"seed": 0, "chosen_by": "the only seed"}
     policy = zoo.load("ROOM", "rl-msg", zoo_dir=copy, spec=trained["map_file"], seed=0)
     assert policy.info["path"].endswith("seed0")
     with pytest.raises(zoo.ZooError, match="no seed 3 of ROOM/rl-msg"):
         zoo.load("ROOM", "rl-msg", zoo_dir=copy, spec=trained["map_file"], seed=3)
-    assert [e["config"]["variant"] for e in zoo.list_entries(copy)] == ["rl-msg"]   # seeds are not entries
+    # a second seed (its config says seed 1): no default until validation picks one
+    shutil.copytree(copy / "ROOM" / "rl-msg" / "seed0", copy / "ROOM" / "rl-msg" / "seed1")
+    path = copy / "ROOM" / "rl-msg" / "seed1" / "config.yml"
+    path.write_text(path.read_text().replace("\nseed: 0\n", "\nseed: 1\n"))
+    assert [e["seed"] for e in zoo.list_entries(copy)] == [0, 1]          # each seed is an entry folder
+    with pytest.raises(zoo.ZooError, match="seeds \\[0, 1\\] and no default.yml; run 'patrolsb3 zoo choose ROOM rl-msg'"):
+        zoo.load("ROOM", "rl-msg", zoo_dir=copy, spec=trained["map_file"])
+    assert main(["zoo", "choose", "ROOM", "rl-msg", "--zoo-dir", str(copy), "--agents", "1,2",
+                 "--episodes", "1", "--steps", "30"]) == 0
+    out = capsys.readouterr().out
+    chosen = yaml.safe_load((copy / "ROOM" / "rl-msg" / "default.yml").read_text())
+    assert f"default: seed {chosen['seed']}" in out and "seed 7" in chosen["chosen_by"]
+    rows = {r["seed"]: r for r in chosen["validation"]}
+    same = ("failures", "bf_rate", "avg_idleness")
+    assert [rows[0][k] for k in same] == [rows[1][k] for k in same] and chosen["seed"] == 0   # a tie: seed order
+    assert zoo.load("ROOM", "rl-msg", zoo_dir=copy, spec=trained["map_file"]).info["path"].endswith("seed0")
+    (copy / "ROOM" / "rl-msg" / "default.yml").write_text("seed: 4\n")
+    with pytest.raises(zoo.ZooError, match="names seed 4, the entry has \\[0, 1\\]"):
+        zoo.load("ROOM", "rl-msg", zoo_dir=copy, spec=trained["map_file"])
+
+
+def test_strategy_names_select_the_setting():
+    assert zoo.parse_strategy("zoo:rl-msg") == ("rl-msg", False)
+    assert zoo.parse_strategy("ZOO:RL-MSG:guarded") == ("rl-msg", True)
+    assert zoo.strategy_name("rl-no-msg", guard=True) == "zoo:rl-no-msg:guarded"
+    for bad, why in (("zoo:rl-msg:shielded", "unknown suffix"), ("zoo:telepathy", "unknown variant"),
+                     ("CR", "not a zoo strategy")):
+        with pytest.raises(zoo.ZooError, match=why):
+            zoo.parse_strategy(bad)
 
 
 def test_config_files_are_read_through_a_schema(tmp_path):
@@ -298,17 +327,15 @@ def test_config_files_are_read_through_a_schema(tmp_path):
         read_config(path)
 
 
-def test_zoo_eval_rewrites_eval_json_with_intervals_and_the_card_shows_them(trained, tmp_path, monkeypatch):
+def test_zoo_eval_rewrites_eval_json_with_intervals_and_the_card_shows_them(trained, tmp_path):
     import shutil
 
     from patrolsb3.cli import main
     from patrolsb3.zoo_cards import card
     copy = tmp_path / "zoo"
     shutil.copytree(trained["root"] / "zoo", copy)
-    monkeypatch.setattr(zoo, "load", lambda m, v, zoo_dir=None, spec=None, seed=None, _load=zoo.load:
-                        _load(m, v, zoo_dir=zoo_dir, spec=trained["map_file"], seed=seed))
     assert main(["zoo", "eval", "ROOM", "rl-msg", "--zoo-dir", str(copy), "--episodes", "3", "--steps", "20"]) == 0
-    entry = zoo.read_entry(copy / "ROOM" / "rl-msg")
+    entry = zoo.read_entry(copy / "ROOM" / "rl-msg" / "seed0")
     assert "ci95" in entry["eval"]["results"][0]["summary"]["avg_idleness"]
     text = card(entry)
     assert "| 1 | " in text and " [" in text.split("| 1 | ", 1)[1].split("\n")[0]   # intervals in the table

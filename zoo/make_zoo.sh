@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # How the zoo was made (run from the repository root), on the 2-core development machine with
 # every run side by side (one torch thread each). Settings and why: zoo/README.md.
+# Since 2026-12-03 these entries (behind the return guard) live in zoo/guarded/; the paths below say so.
 #
 # Stage 1 (patrol only). This time A's three runs were started ten minutes before B, C and D,
 # and stopped at their 1,250,000-step checkpoints (~63 min wall, 0.37-0.39 CPU h each); B, C
@@ -118,28 +119,28 @@ zoo/train_stages.sh 2 3300
 # Export (policy only) with the CPU hours of both stages (CPU_HOURS: "A:rl-msg=0.8 ..."), the
 # stage-1 learning curve and command beside the stage-2 ones, and eval.json (10 episodes x
 # 14,400 steps for n = 1..5, seed 0, deterministic actions).
-rm -rf zoo/A zoo/B zoo/C zoo/D
+rm -rf zoo/guarded/A zoo/guarded/B zoo/guarded/C zoo/guarded/D
 CPU_HOURS=${CPU_HOURS:-"A:rl-msg=0.65 A:rl-no-msg=0.66 A:rl-intention=0.65 B:rl-msg=0.50 C:rl-msg=0.50 D:rl-msg=0.50"}
 for entry in $CPU_HOURS; do
   run=${entry%%=*}; map=${run%%:*}; variant=${run#*:}
   ( patrolsb3 zoo export "runs/zoo/$map/$variant/MaskableRecurrentPPO_seed0" --cpu-hours "${entry#*=}" \
       --episodes 10 --steps 14400 --seed 0 > "runs/logs/export_${map}_${variant}.log" 2>&1
-    cp "runs/stage1/$map/$variant/MaskableRecurrentPPO_seed0/curve.csv" "zoo/$map/$variant/curve_stage1.csv"
-    cp "runs/stage1/$map/$variant/MaskableRecurrentPPO_seed0/command.txt" "zoo/$map/$variant/command_stage1.txt" ) &
+    cp "runs/stage1/$map/$variant/MaskableRecurrentPPO_seed0/curve.csv" "zoo/guarded/$map/$variant/curve_stage1.csv"
+    cp "runs/stage1/$map/$variant/MaskableRecurrentPPO_seed0/command.txt" "zoo/guarded/$map/$variant/command_stage1.txt" ) &
 done
 wait
-patrolsb3 compare --maps A,B,C,D --agents 1-5 --episodes 10 --steps 14400 --seed 0 --out zoo/comparison
+patrolsb3 compare --maps A,B,C,D --agents 1-5 --episodes 10 --steps 14400 --seed 0 --out zoo/guarded/comparison
 # the same models sampling their actions (--stochastic; 6 h episodes, for time): eval_sampled.json beside eval.json,
-# and their tables in zoo/comparison_sampled (zoo models only; the heuristics are above)
+# and their tables in zoo/guarded/comparison_sampled (zoo models only; the heuristics are above)
 for entry in $CPU_HOURS; do
   run=${entry%%=*}; map=${run%%:*}; variant=${run#*:}
   ( patrolsb3 zoo export "runs/zoo/$map/$variant/MaskableRecurrentPPO_seed0" --zoo-dir runs/zoo_sampled \
       --stochastic --episodes 10 --steps 3600 --seed 0 > "runs/logs/sampled_${map}_${variant}.log" 2>&1
-    cp "runs/zoo_sampled/$map/$variant/eval.json" "zoo/$map/$variant/eval_sampled.json" ) &
+    cp "runs/zoo_sampled/guarded/$map/$variant/eval.json" "zoo/guarded/$map/$variant/eval_sampled.json" ) &
 done
 wait
 python -c "
 import glob, json
 from patrolsb3.report import write_compare
-results = [r for f in sorted(glob.glob('zoo/*/*/eval_sampled.json')) for r in json.load(open(f))['results']]
-write_compare(results, 'zoo/comparison_sampled')"
+results = [r for f in sorted(glob.glob('zoo/guarded/*/*/eval_sampled.json')) for r in json.load(open(f))['results']]
+write_compare(results, 'zoo/guarded/comparison_sampled')"

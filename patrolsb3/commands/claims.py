@@ -5,6 +5,9 @@ interval and a verdict, from a comparison's results (``patrolsb3.claims``)."""
 def add_arguments(parser):
     parser.add_argument("compare_dir", metavar="COMPARE_DIR", help="a 'patrolsb3 compare' output folder")
     parser.add_argument("--zoo-dir", default=None, help="the zoo whose training curves to read (default: zoo/)")
+    parser.add_argument("--guarded", action="store_true",
+                        help="test the claims on the entries behind the return guard (columns "
+                             "zoo:<variant>:guarded, curves from zoo/guarded/) instead of the paper's setting")
     parser.add_argument("--faults-result", default=None, metavar="FILE",
                         help="an 'evaluate --faults STEP:K --json' result, for the claim on failing agents")
     parser.add_argument("--json", default=None, metavar="FILE", help="also write the rows as JSON")
@@ -20,6 +23,11 @@ def run(args):
     if args.json:
         check_output_file(args.json, "--json")
     figures = read_figures(args.compare_dir)
+    if args.guarded:   # the guarded columns stand in for the learned variants; paper-setting ones are left out
+        suffix = f":{zoo.GUARDED}"
+        figures = {(m, n, name.removesuffix(suffix), metric): f for (m, n, name, metric), f in figures.items()
+                   if name.endswith(suffix) or not name.startswith("zoo:")
+                   or not any(k[2] == name + suffix for k in figures)}
     faults = None
     if args.faults_result:
         path = Path(args.faults_result)
@@ -30,7 +38,9 @@ def run(args):
             raise ValueError(f"--faults-result {path}: no such file") from None
         except (ValueError, KeyError, TypeError):
             raise ValueError(f"--faults-result {path}: not an 'evaluate --json' result") from None
-    curves = {m: {v: p for v in zoo.VARIANT_NAMES if (p := zoo.entry_dir(m, v, args.zoo_dir) / "curve.csv").is_file()}
+    curves = {m: {v: p for v in zoo.VARIANT_NAMES
+                  if zoo.available(m, v, args.zoo_dir, guard=args.guarded)
+                  and (p := zoo.entry_dir(m, v, args.zoo_dir, guard=args.guarded) / "curve.csv").is_file()}
               for m in sorted({k[0] for k in figures})}
     rows = claims(figures, curves=curves, faults_result=faults)
     print(claims_table(rows))

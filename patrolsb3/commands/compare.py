@@ -1,6 +1,8 @@
 """``patrolsb3 compare``: every strategy x maps x team sizes -> the paper's tables, a markdown
-report and plots (see ``patrolsb3.report``). Zoo columns (INTENTION, NOMSG, MSG) are filled
-when ``patrolsb3.zoo`` has a model for the map, empty otherwise. Heuristic results are kept in
+report and plots (see ``patrolsb3.report``). Zoo columns (INTENTION, NOMSG, MSG) are the entries
+in the paper's setting (no return guard), filled when ``patrolsb3.zoo`` has one for the map and
+said to be missing otherwise; the entries behind the guard are columns only when asked for
+(``--strategies ...,zoo:rl-msg:guarded``). Heuristic results are kept in
 ``OUT/results.json`` as they finish (``patrolsb3.result_store``): the same command again
 resumes an interrupted comparison or redraws a finished one without running it again."""
 
@@ -25,11 +27,21 @@ def parse_agents(text: str) -> list[int]:
 def zoo_note(zoo, map_name: str, strategy: str, reused: bool) -> str:
     """The report's line about a zoo column: its setting (behind the return guard or the paper's)
     and whether its figures were reused from the entry's eval.json or computed now."""
-    config = zoo.read_entry(zoo.entry_dir(map_name, strategy.split(":", 1)[1]))["config"]
+    variant, guard = zoo.parse_strategy(strategy)
+    folder = zoo.entry_dir(map_name, variant, guard=guard)
+    config = zoo.read_entry(folder)["config"]
     guarded = bool((config.get("env") or {}).get("return_guard"))
     setting = ("behind the return guard (env.return_guard, ours: the heuristics' recharge rule as a "
                "shield)" if guarded else "the paper's setting (no return guard)")
-    return f"{setting}; figures {'reused from its eval.json' if reused else 'computed now'}"
+    which = "" if guard else f"training seed {config.get('seed', '?')} ({default_reason(zoo, map_name, variant)}), "
+    return f"{setting}; {which}figures {'reused from its eval.json' if reused else 'computed now'}"
+
+
+def default_reason(zoo, map_name: str, variant: str) -> str:
+    """Why the paper-setting entry's default seed is the default, for the report."""
+    chosen = zoo.default_seed(map_name, variant) or {}
+    have = zoo.seeds(map_name, variant)
+    return f"{chosen.get('chosen_by', '?')}; the entry has {len(have)} seed{'s' if len(have) != 1 else ''}"
 
 
 def timed(function, **kwargs):
@@ -107,11 +119,16 @@ def run(args):
     for name in (args.strategies or "").split(","):
         name = canonical_name(name) if name.strip() else ""
         if name and not name.startswith("zoo:") and name not in REGISTRY:
-            raise ValueError(f"unknown strategy {name!r}; known: {', '.join(REGISTRY)} or zoo:<variant>")
+            raise ValueError(f"unknown strategy {name!r}; known: {', '.join(REGISTRY)}, zoo:<variant> "
+                             f"or zoo:<variant>:guarded")
         if name.startswith("zoo:"):
-            missing = [m for m in maps if zoo is None or not zoo.available(m, name.split(":", 1)[1])]
+            if zoo is None:
+                raise ValueError(f"{name}: patrolsb3.zoo cannot be imported")
+            variant, guard = zoo.parse_strategy(name)
+            missing = [m for m in maps if not zoo.available(m, variant, guard=guard)]
             if missing:
-                raise ValueError(f"{name}: no zoo model for map(s) {', '.join(missing)}")
+                raise ValueError(f"{name}: no zoo model for map(s) {', '.join(missing)}"
+                                 + ("" if guard else " in the paper's setting"))
     if args.address and not args.ray:
         raise ValueError("--address joins a Ray cluster: give it with --ray")
     if args.ray:
@@ -125,14 +142,20 @@ def run(args):
         else:
             names = ["CR", "PART", "SEBS", *EXTRA_COLUMNS]
             if zoo is not None:
-                names += [s for s in ZOO_COLUMNS.values() if zoo.available(m, s.split(":", 1)[1])]
+                names += [s for s in ZOO_COLUMNS.values() if zoo.available(m, zoo.parse_strategy(s)[0])]
+                absent = [s for s in ZOO_COLUMNS.values() if s not in names]
+                if absent:
+                    print(f"map {m.upper()}: no entry in the paper's setting for {', '.join(absent)}; those "
+                          f"columns stay empty (the entries behind the return guard: --strategies "
+                          f"...,{absent[0]}:guarded)", flush=True)
         cells += [(m, name, n) for name in names for n in sizes]
     found, sources = {}, {}
     for m, name, n in cells:         # what a zoo entry's eval.json or results.json already holds
         r = None
         if zoo is not None and name.startswith("zoo:") and not args.rerun_zoo:
-            r = zoo.cached_result(m, name.split(":", 1)[1], n, args.episodes, args.steps,
-                                  args.seed, args.tests, deterministic=not args.stochastic)
+            variant, guard = zoo.parse_strategy(name)
+            r = zoo.cached_result(m, variant, n, args.episodes, args.steps, args.seed, args.tests,
+                                  deterministic=not args.stochastic, guard=guard)
             sources[(m, name, n)] = "  (from the zoo's eval.json; --rerun-zoo to run it)" if r else ""
         if r is None and not args.rerun and not name.startswith("zoo:"):
             spec, cfg = evaluation_setup(m, n, args.episodes, args.tests, args.steps)
@@ -161,11 +184,12 @@ def run(args):
     results = [found[c] for c in cells]
     zoo_notes = {(m.upper(), name): zoo_note(zoo, m, name, reused=bool(sources.get((m, name, n))))
                  for m, name, n in cells if name.startswith("zoo:")}
-    curves = {}
-    if zoo is not None:
-        for m in maps:
-            curves[m.upper()] = {v: p for v in zoo.VARIANT_NAMES
-                                 if (p := zoo.entry_dir(m, v) / "curve.csv").is_file()}
+    curves = {}                      # {MAP: {variant (or variant:guarded): curve.csv}} of the zoo columns
+    for m, name, n in cells:
+        if name.startswith("zoo:"):
+            variant, guard = zoo.parse_strategy(name)
+            if (path := zoo.entry_dir(m, variant, guard=guard) / "curve.csv").is_file():
+                curves.setdefault(m.upper(), {})[name[4:]] = path
     paths = write_compare(results, args.out, learning_curves=curves, zoo_notes=zoo_notes)
     print(f"wrote {len(paths)} files to {args.out} (report: {args.out}/report.md)")
     return 0

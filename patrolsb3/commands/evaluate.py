@@ -3,7 +3,8 @@
 
 def add_arguments(parser):
     parser.add_argument("--strategy", required=True,
-                        help="RANDOM, CR, PART, SEBS, CYCLIC (case-insensitive) or zoo:<variant>")
+                        help="RANDOM, CR, PART, SEBS, CYCLIC (case-insensitive), zoo:<variant> (the paper's setting) "
+                             "or zoo:<variant>:guarded (the entries behind the return guard)")
     parser.add_argument("--map", default="A", help="map name A-D or a map file (default A)")
     parser.add_argument("--agents", type=int, default=3, help="team size (default 3)")
     parser.add_argument("--episodes", type=int, default=100, help="episodes per test (default 100)")

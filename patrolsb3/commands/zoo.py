@@ -3,7 +3,9 @@ figures; ``patrolsb3 zoo show MAP VARIANT``: one entry's config and evaluation; 
 export RUN``: a run into the zoo; ``patrolsb3 zoo validate RUN``: rank a run's checkpoints;
 ``patrolsb3 zoo listening MAP VARIANT``: what its messages carry (:mod:`patrolsb3.listening`);
 ``patrolsb3 zoo ablation MAP VARIANT``: what the team loses when it cannot trust them
-(:mod:`patrolsb3.ablation`)."""
+(:mod:`patrolsb3.ablation`); ``patrolsb3 zoo choose MAP VARIANT``: the default seed, by
+validation. MAP VARIANT means the paper's setting; ``--guarded`` the entries behind the return
+guard, ``--seed-of-entry K`` one training seed."""
 import json
 import math
 
@@ -16,6 +18,10 @@ def add_arguments(parser):
     p_show.add_argument("map")
     p_show.add_argument("variant")
     p_show.add_argument("--zoo-dir", default=None)
+    p_show.add_argument("--guarded", action="store_true",
+                       help="the entry behind the return guard (zoo/guarded/), not the paper's setting")
+    p_show.add_argument("--seed-of-entry", type=int, default=None, dest="entry_seed",
+                       help="one training seed's model (default: the entry's default seed)")
     p_export = sub.add_parser("export", help="copy a training run into the zoo (policy only) and "
                                              "evaluate it for 1..max_agents agents into eval.json")
     p_export.add_argument("run_dir", help="run folder of 'patrolsb3 train'")
@@ -45,10 +51,23 @@ def add_arguments(parser):
     p_eval.add_argument("map")
     p_eval.add_argument("variant")
     p_eval.add_argument("--zoo-dir", default=None)
+    p_eval.add_argument("--guarded", action="store_true",
+                       help="the entry behind the return guard (zoo/guarded/), not the paper's setting")
+    p_eval.add_argument("--seed-of-entry", type=int, default=None, dest="entry_seed",
+                       help="one training seed's model (default: the entry's default seed)")
     p_eval.add_argument("--episodes", type=int, default=10, help="episodes per team size (default 10)")
     p_eval.add_argument("--steps", type=int, default=14400, help="steps per episode (default 14400)")
     p_eval.add_argument("--seed", type=int, default=0)
     p_eval.add_argument("--stochastic", action="store_true", help="sampled actions instead of greedy")
+    p_choose = sub.add_parser("choose", help="pick the paper-setting entry's default seed by the greedy "
+                                             "validation of 'zoo validate' and write its default.yml")
+    p_choose.add_argument("map")
+    p_choose.add_argument("variant")
+    p_choose.add_argument("--zoo-dir", default=None)
+    p_choose.add_argument("--agents", default="1,3,5", help="team sizes (default 1,3,5)")
+    p_choose.add_argument("--episodes", type=int, default=4, help="episodes per team size (default 4)")
+    p_choose.add_argument("--steps", type=int, default=3000, help="steps per episode (default 3000)")
+    p_choose.add_argument("--seed", type=int, default=7, help="simulator seed (default 7; the zoo's eval uses 0)")
     p_cards = sub.add_parser("cards", help="write one model card (markdown) per entry and an index")
     p_cards.add_argument("--out", default="docs/zoo", help="folder of the cards (default docs/zoo)")
     p_cards.add_argument("--zoo-dir", default=None)
@@ -58,6 +77,10 @@ def add_arguments(parser):
     p_lis.add_argument("map")
     p_lis.add_argument("variant", help="rl-msg or rl-intention")
     p_lis.add_argument("--zoo-dir", default=None)
+    p_lis.add_argument("--guarded", action="store_true",
+                       help="the entry behind the return guard (zoo/guarded/), not the paper's setting")
+    p_lis.add_argument("--seed-of-entry", type=int, default=None, dest="entry_seed",
+                       help="one training seed's model (default: the entry's default seed)")
     p_lis.add_argument("--agents", type=int, default=3, help="team size (default 3)")
     p_lis.add_argument("--episodes", type=int, default=8, help="parallel episodes (default 8)")
     p_lis.add_argument("--steps", type=int, default=500, help="simulator steps (default 500)")
@@ -67,8 +90,10 @@ def add_arguments(parser):
     p_abl.add_argument("map")
     p_abl.add_argument("variant", help="rl-msg or rl-intention")
     p_abl.add_argument("--zoo-dir", default=None)
+    p_abl.add_argument("--guarded", action="store_true",
+                       help="the entry behind the return guard (zoo/guarded/), not the paper's setting")
     p_abl.add_argument("--seed-of-entry", type=int, default=None, dest="entry_seed",
-                       help="one training seed's model (default: the entry's)")
+                       help="one training seed's model (default: the entry's default seed)")
     p_abl.add_argument("--agents", type=int, default=3, help="team size (default 3)")
     p_abl.add_argument("--episodes", type=int, default=10, help="episodes (default 10)")
     p_abl.add_argument("--steps", type=int, default=2000, help="simulator steps per episode (default 2000)")
@@ -100,15 +125,33 @@ def headline(entry: dict) -> str:
     return (f"eval {ev['episodes']} episodes x {ev['steps']} steps: " + "; ".join(parts))
 
 
+def team_sizes(text) -> tuple[int, ...]:
+    """'1,3,5' -> (1, 3, 5); a one-line error naming --agents otherwise."""
+    try:
+        return tuple(int(n) for n in str(text).split(","))
+    except ValueError:
+        raise ValueError(f"--agents {text!r}: give team sizes like 1,3,5") from None
+
+
+def chosen_entry(args):
+    """The entry folder MAP VARIANT [--guarded] [--seed-of-entry K] names; it must hold a model.
+
+    Raises:
+        ZooError: no such entry or seed (:func:`patrolsb3.zoo.existing_entry_dir`).
+    """
+    from ..zoo import existing_entry_dir
+    return existing_entry_dir(args.map, args.variant, args.zoo_dir, seed=args.entry_seed, guard=args.guarded)
+
+
 def run(args):
-    from ..zoo import entry_dir, list_entries, read_entry
+    from ..zoo import list_entries, load_entry, read_entry
     if args.zoo_command == "export":
         return export_and_evaluate(args)
     if args.zoo_command == "validate":
         return validate_checkpoints(args)
     if args.zoo_command == "eval":
         from ..evaluate import write_zoo_eval
-        path = write_zoo_eval(entry_dir(args.map, args.variant, args.zoo_dir), episodes=args.episodes,
+        path = write_zoo_eval(chosen_entry(args), episodes=args.episodes,
                               steps=args.steps, seed=args.seed, deterministic=not args.stochastic)
         print(f"evaluation written to {relative_path(path)}")
         return 0
@@ -121,21 +164,19 @@ def run(args):
         return 0
     if args.zoo_command == "listening":
         from ..listening import listening
-        from ..zoo import load
-        figures = listening(load(args.map, args.variant, zoo_dir=args.zoo_dir), n_agents=args.agents,
+        figures = listening(load_entry(chosen_entry(args)), n_agents=args.agents,
                             episodes=args.episodes, steps=args.steps, seed=args.seed)
         print(json.dumps({"entry": f"{args.map.upper()}/{args.variant}", **figures}))
         return 0
     if args.zoo_command == "ablation":
         from ..ablation import ablation_table, message_ablation
         from ..outputs import check_output_file, write_json
-        from ..zoo import load
         if args.json:
             check_output_file(args.json, "--json")
         for name in ("agents", "episodes", "steps"):
             if getattr(args, name) < 1:
                 raise ValueError(f"--{name} must be >= 1, got {getattr(args, name)}")
-        policy = load(args.map, args.variant, zoo_dir=args.zoo_dir, seed=args.entry_seed)
+        policy = load_entry(chosen_entry(args))
         figures = message_ablation(policy, n_agents=args.agents, episodes=args.episodes, steps=args.steps,
                                    seed=args.seed)
         print(ablation_table(f"{args.map.upper()}/{args.variant}", figures))
@@ -143,9 +184,21 @@ def run(args):
             write_json(args.json, {"entry": f"{args.map.upper()}/{args.variant}", **figures}, indent=2)
         return 0
     if args.zoo_command == "show":
-        entry = read_entry(entry_dir(args.map, args.variant, args.zoo_dir))
+        entry = read_entry(chosen_entry(args))
         entry["path"] = relative_path(entry["path"])      # no path of this machine in the output
         print(json.dumps(entry, indent=2, default=str))
+        return 0
+    if args.zoo_command == "choose":
+        from ..zoo import choose_default
+        for name in ("episodes", "steps"):
+            if getattr(args, name) < 1:
+                raise ValueError(f"--{name} must be >= 1, got {getattr(args, name)}")
+        chosen = choose_default(args.map, args.variant, zoo_dir=args.zoo_dir, team_sizes=team_sizes(args.agents),
+                                episodes=args.episodes, steps=args.steps, seed=args.seed)
+        for row in chosen["validation"]:
+            print(f"seed {row['seed']}: failures/episode {row['failures']:.2f}  BF rate {row['bf_rate']:.2f}  "
+                  f"AVG^h {row['avg_idleness']:.1f}")
+        print(f"default: seed {chosen['seed']} ({chosen['chosen_by']})")
         return 0
     entries = list_entries(args.zoo_dir)
     if not entries:
@@ -154,7 +207,8 @@ def run(args):
     for e in entries:
         c = e["config"]
         budget = c.get("budget", {})
-        print(f"{c.get('map', '?')}/{c.get('variant', '?')}  algo {c.get('algo', '?')}  "
+        where = f"/seed{e['seed']}" if e["seed"] is not None else ""
+        print(f"{c.get('map', '?')}/{c.get('variant', '?')}{where}  algo {c.get('algo', '?')}  "
               f"env {c.get('env_version', '?')}  trained {c.get('date', '?')}  "
               f"{budget.get('timesteps', '?')} steps, {budget.get('cpu_hours', '?')} CPU h"
               + ("  behind the return guard (env.return_guard, ours)"
@@ -181,10 +235,7 @@ def export_and_evaluate(args) -> int:
 def validate_checkpoints(args) -> int:
     """``patrolsb3 zoo validate``: one line per checkpoint, then the best by failures and AVG^h."""
     from ..checkpoints import rank, run_checkpoints, validate
-    try:
-        sizes = tuple(int(n) for n in str(args.agents).split(","))
-    except ValueError:
-        raise ValueError(f"--agents {args.agents!r}: give team sizes like 1,3,5") from None
+    sizes = team_sizes(args.agents)
     paths = run_checkpoints(args.run_dir)
     if args.last:
         paths = paths[-args.last:]

@@ -67,6 +67,43 @@ def sequence_breaks(kept: np.ndarray, n_steps: int) -> np.ndarray:
     return breaks
 
 
+def team_gap(rewards: np.ndarray, deployed: np.ndarray, episode_of_rows: np.ndarray) -> np.ndarray:
+    """(n_envs,) each deployed row's team mean reward minus its own, for one env step.
+
+    Args:
+        rewards: (n_envs,) this step's rewards.
+        deployed: (n_envs,) bool rows that act (padded slots: gap 0, not in any mean).
+        episode_of_rows: (n_envs,) int the parallel episode of each row (its team).
+    """
+    n = int(episode_of_rows.max()) + 1
+    weight = deployed.astype(np.float64)                                        # (n_envs,)
+    total = np.bincount(episode_of_rows, weights=rewards * weight, minlength=n)  # (n,)
+    count = np.bincount(episode_of_rows, weights=weight, minlength=n)            # (n,)
+    mean = total / np.maximum(count, 1.0)
+    return np.where(deployed, mean[episode_of_rows] - rewards, 0.0)
+
+
+def discounted_gaps(gaps: np.ndarray, episode_starts: np.ndarray, last_dones: np.ndarray,
+                    discount: float) -> np.ndarray:
+    """(n_steps, n_envs) G_t = gap_t + discount * G_{t+1} within each episode, 0 past the
+    rollout: what the team's reward adds to a row's GAE advantage (discount = gamma * lambda)
+    when its own reward is replaced by the team mean.
+
+    Args:
+        gaps: (n_steps, n_envs) team mean minus own reward of every step.
+        episode_starts: (n_steps, n_envs) 1 where a row's episode starts at that step.
+        last_dones: (n_envs,) episodes that ended at the rollout's last step.
+        discount: gamma * gae_lambda.
+    """
+    out = np.zeros_like(gaps, dtype=np.float64)
+    following = np.zeros(gaps.shape[1])
+    for t in reversed(range(len(gaps))):
+        cut = last_dones if t == len(gaps) - 1 else episode_starts[t + 1]
+        following = gaps[t] + discount * (1.0 - cut) * following
+        out[t] = following
+    return out
+
+
 class MaskableRecurrentRolloutBuffer(RecurrentRolloutBuffer):
     """Recurrent rollout buffer with action masks and deployed-row flags (module docstring).
 
@@ -80,18 +117,32 @@ class MaskableRecurrentRolloutBuffer(RecurrentRolloutBuffer):
         self.mask_dims = mask_dims(self.action_space)
         self.action_masks = np.ones((self.buffer_size, self.n_envs, self.mask_dims), dtype=np.float32)
         self.deployed = np.ones((self.buffer_size, self.n_envs), dtype=bool)
+        self.team_gaps = np.zeros((self.buffer_size, self.n_envs), dtype=np.float32)   # team mean - own reward
         self.n_rows = self.buffer_size * self.n_envs
         self.env_change = None
         super().reset()
 
     def add(self, *args, action_masks: np.ndarray | None = None, deployed: np.ndarray | None = None,
-            **kwargs) -> None:
-        """RecurrentRolloutBuffer.add plus the (n_envs, mask_dims) masks of this step and the
-        (n_envs,) flags of the rows that are deployed (None: all)."""
+            team_gaps: np.ndarray | None = None, **kwargs) -> None:
+        """RecurrentRolloutBuffer.add plus the (n_envs, mask_dims) masks of this step, the
+        (n_envs,) flags of the rows that are deployed (None: all) and, for a team share of the
+        reward, the (n_envs,) team-mean-minus-own rewards of this step (:func:`team_gap`)."""
+        if team_gaps is not None:
+            self.team_gaps[self.pos] = team_gaps
         if action_masks is not None:
             self.action_masks[self.pos] = np.asarray(action_masks).reshape((self.n_envs, self.mask_dims))
         self.deployed[self.pos] = True if deployed is None else np.asarray(deployed, dtype=bool)
         super().add(*args, **kwargs)
+
+    def share_team_reward(self, share: float, n_symbols: int, last_dones: np.ndarray) -> None:
+        """Give message rows a ``share`` of the team's reward: once the GAE advantages are
+        computed, add ``share * G`` (:func:`discounted_gaps` of the stored team gaps) to the
+        advantage of every deployed row whose message head has a choice. Their returns (the
+        critic's targets) and every other row stay as they were; the critic is the agent's own."""
+        speaking = self.deployed & (self.action_masks[..., :n_symbols].sum(axis=-1) > 1)   # (n_steps, n_envs)
+        gaps = discounted_gaps(self.team_gaps, self.episode_starts, np.asarray(last_dones, dtype=np.float64),
+                               self.gamma * self.gae_lambda)
+        self.advantages = np.where(speaking, self.advantages + share * gaps, self.advantages).astype(np.float32)
 
     def prepare(self) -> None:
         """Flatten every field env-major and keep the deployed rows only (once per rollout)."""

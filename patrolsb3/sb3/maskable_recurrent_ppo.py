@@ -31,7 +31,7 @@ from stable_baselines3.common.utils import explained_variance, obs_as_tensor
 from stable_baselines3.common.vec_env import VecEnv
 
 from ..core.observe import PHASE_INDEX
-from .buffers import MaskableRecurrentRolloutBuffer
+from .buffers import MaskableRecurrentRolloutBuffer, team_gap
 from .policy import PatrolRecurrentPolicy
 
 
@@ -70,7 +70,8 @@ class MaskableRecurrentPPO(RecurrentPPO):
     policy_aliases: ClassVar[dict] = {"PatrolRecurrentPolicy": PatrolRecurrentPolicy}
 
     def __init__(self, *args, n_minibatches: int | None = None, ent_coef_message: float | None = None,
-                 signal_coef: float | None = None, listen_coef: float | None = None, **kwargs):
+                 signal_coef: float | None = None, listen_coef: float | None = None,
+                 message_team_share: float | None = None, **kwargs):
         """Args as :class:`sb3_contrib.RecurrentPPO`, plus
 
         Args:
@@ -92,13 +93,23 @@ class MaskableRecurrentPPO(RecurrentPPO):
                 received symbols removed (the others' symbol planes cleared; that branch is
                 computed without gradient). Needs legible messages (``message_encoding``
                 'planes'). None or 0: none.
+            message_team_share: a team share of the reward on message rows (OURS), 0..1: the
+                advantage of a row whose message head has a choice is computed as if the
+                row's own reward were ``(1 - share) * own + share * team mean`` (the mean over
+                its episode's deployed slots), so a speaker is paid for what its symbol does
+                for the others; move rows and the critic's targets keep the own reward (the
+                baseline stays the agent's own value, an approximation). Needs a vec env with
+                ``episode_of_rows()`` (ours). None or 0: none.
         """
         if n_minibatches is not None and int(n_minibatches) < 1:
             raise ValueError(f"n_minibatches must be >= 1, got {n_minibatches}")
         for name, value in (("ent_coef_message", ent_coef_message), ("signal_coef", signal_coef),
-                            ("listen_coef", listen_coef)):
+                            ("listen_coef", listen_coef), ("message_team_share", message_team_share)):
             if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
                 raise ValueError(f"{name} must be a number or None, got {value!r}")
+        if message_team_share is not None and not 0.0 <= float(message_team_share) <= 1.0:
+            raise ValueError(f"message_team_share must be between 0 and 1, got {message_team_share}")
+        self.message_team_share = None if message_team_share is None else float(message_team_share)
         self.n_minibatches = None if n_minibatches is None else int(n_minibatches)
         self.ent_coef_message = None if ent_coef_message is None else float(ent_coef_message)
         self.signal_coef = None if signal_coef is None else float(signal_coef)
@@ -139,6 +150,14 @@ class MaskableRecurrentPPO(RecurrentPPO):
         dones = self._last_episode_starts
         new_obs = self._last_obs
         nvec = self.action_space.nvec
+        share = getattr(self, "message_team_share", None)         # absent in older checkpoints
+        episode_of_rows = None
+        if share:
+            method = getattr(env, "episode_of_rows", None)
+            if not callable(method):
+                raise ValueError("message_team_share needs a vec env with episode_of_rows() (patrolsb3.sb3."
+                                 "make_vec_env provides it)")
+            episode_of_rows = np.asarray(method(), dtype=np.int64)                 # (n_envs,)
         while n_steps < n_rollout_steps:
             action_masks = env_action_masks(env)                                   # (n_envs, 21)
             deployed = env_deployed_rows(env)                                      # (n_envs,)
@@ -151,9 +170,11 @@ class MaskableRecurrentPPO(RecurrentPPO):
                 return False
             self._update_info_buffer(infos, dones)
             n_steps += 1
-            self._bootstrap_truncated(rewards, dones, infos, lstm_states, deployed)
+            gaps = None if episode_of_rows is None else team_gap(rewards, deployed, episode_of_rows)
+            self._bootstrap_truncated(rewards, dones, infos, lstm_states, deployed)   # after the gaps: raw rewards there
             rollout_buffer.add(self._last_obs, actions, rewards, self._last_episode_starts, values, log_probs,
-                               lstm_states=self._last_lstm_states, action_masks=action_masks, deployed=deployed)
+                               lstm_states=self._last_lstm_states, action_masks=action_masks, deployed=deployed,
+                               team_gaps=gaps)
             self._last_obs = new_obs
             self._last_episode_starts = dones
             self._last_lstm_states = lstm_states
@@ -161,6 +182,8 @@ class MaskableRecurrentPPO(RecurrentPPO):
             episode_starts = th.tensor(dones, dtype=th.float32, device=self.device)
             values = self.policy.predict_values(obs_as_tensor(new_obs, self.device), lstm_states.vf, episode_starts)
         rollout_buffer.compute_returns_and_advantage(last_values=values, dones=dones)
+        if share:
+            rollout_buffer.share_team_reward(share, int(nvec[0]), dones)
         callback.on_rollout_end()
         return True
 

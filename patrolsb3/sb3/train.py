@@ -26,7 +26,7 @@ from .cpu_time import cpu_hours_of
 from .curriculum import CURRICULUM
 from .hyperparams import load_hyperparams, merge, per_phase, schedule
 
-COMMUNICATION_KEYS = ("ent_coef_message", "signal_coef", "listen_coef")
+COMMUNICATION_KEYS = ("ent_coef_message", "signal_coef", "listen_coef", "message_team_share")
 """Optional coefficients of MaskableRecurrentPPO for learned messages (None: off)."""
 ALGO_KEYS = ("learning_rate", "n_steps", "n_epochs", "gamma", "gae_lambda", "clip_range", "ent_coef",
              "vf_coef", "max_grad_norm", "n_minibatches", "batch_size", "policy_kwargs", "target_kl",
@@ -180,6 +180,9 @@ def check_run_settings(hp: dict, total) -> None:
         if hp.get(key) is not None and get_algorithm(hp.get("algo", DEFAULT_ALGORITHM)).name \
                 != "MaskableRecurrentPPO":
             raise ValueError(f"{key} is a setting of MaskableRecurrentPPO, not of {hp.get('algo')}")
+    if hp.get("message_team_share") is not None and not 0.0 <= float(hp["message_team_share"]) <= 1.0:
+        raise ValueError(f"message_team_share must be between 0 and 1 (a share of the team's reward), got "
+                         f"{hp['message_team_share']}")
     if hp.get("listen_coef") and (hp.get("env") or {}).get("message_encoding", EnvConfig.message_encoding) != "planes":
         raise ValueError("listen_coef needs legible messages: set env.message_encoding=planes (with "
                          "'scalar' messages the received symbols have no channel of their own)")

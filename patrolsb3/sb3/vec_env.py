@@ -134,6 +134,10 @@ class PatrolVecEnv(VecEnvWrapper):
         """(num_envs,) bool: rows of deployed slots (the others are padding and never act)."""
         return self.episodes.deployed_rows()
 
+    def episode_of_rows(self) -> np.ndarray:
+        """(num_envs,) int64: the parallel episode (team) of each row."""
+        return np.arange(self.num_envs, dtype=np.int64) // self.max_agents
+
     def action_masks(self) -> np.ndarray:
         """(num_envs, n_symbols + 5) bool: message mask then move mask of every row, for the
         current phase."""

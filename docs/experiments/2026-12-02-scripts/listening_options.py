@@ -1,6 +1,7 @@
 """What each communication option does to the listening figure, on a tiny room (short runs).
 
-Usage: python listening_options.py OUT [STEPS] [SEEDS]: for each setting below, train rl-msg on
+Usage: python listening_options.py OUT [STEPS] [SEEDS] [SETTINGS]: for each setting below (or
+those named, comma-separated, in SETTINGS), train rl-msg on
 the 4 x 6 room ROOM (zoo-stage1 recipe: 300-step episodes, full batteries, planes messages; no
 curriculum; teams 1,1,1,1,2,3,3,3 of max 3) for STEPS agent-steps (default 150,000) per seed, then
 print the listening figure of the final policy (2 agents, 8 episodes x 300 steps, seed 1000) and
@@ -20,11 +21,14 @@ from patrolsb3.zoo import load_checkpoint
 ROOM = "S.....\n..#...\n...5..\n......\n"
 SETTINGS = {"baseline": {}, "ent_coef_message=0.01": {"ent_coef_message": 0.01},
             "signal_coef=0.05": {"signal_coef": 0.05}, "listen_coef=0.05": {"listen_coef": 0.05}, "listen_coef=0.5": {"listen_coef": 0.5},
-            "listen_coef=0.5+signal_coef=0.05": {"listen_coef": 0.5, "signal_coef": 0.05}}
+            "listen_coef=0.5+signal_coef=0.05": {"listen_coef": 0.5, "signal_coef": 0.05},
+            "message_team_share=0.5": {"message_team_share": 0.5}, "message_team_share=1": {"message_team_share": 1.0}}
 
 out = Path(sys.argv[1])
 steps = int(sys.argv[2]) if len(sys.argv) > 2 else 150_000
 seeds = range(int(sys.argv[3]) if len(sys.argv) > 3 else 1)
+if len(sys.argv) > 4:
+    SETTINGS = {name: SETTINGS[name] for name in sys.argv[4].split(",")}
 out.mkdir(parents=True, exist_ok=True)
 room = out / "room.txt"
 room.write_text(ROOM)
