@@ -254,6 +254,6 @@ def _not_better(figures: dict, who: str, than: str, metric: str) -> dict:
 
 def claims_table(rows: list[dict]) -> str:
     """The claims as a markdown table."""
-    lines = ["| the paper's claim | our figure (95 % intervals over episodes) | verdict |", "|---|---|---|"]
+    lines = ["| the paper's claim | our figure (95 % intervals over episodes, and over training seeds where a zoo column pools several) | verdict |", "|---|---|---|"]
     lines += [f"| {r['claim']} | {r['figure']} | **{r['verdict']}** |" for r in rows]
     return "\n".join(lines)

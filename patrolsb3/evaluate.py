@@ -149,9 +149,10 @@ def summarize(per_episode: dict, tests: int) -> dict:
         tests: number of tests.
 
     Returns:
-        dict metric -> {"mean", "std", "tests": [per-test values], "ci95": [low, high]}: std over
-        tests, and a 95 % bootstrap interval of the mean over the episodes themselves
-        (:func:`interval95`; the episodes a metric counts), plus ``clean_episodes`` (per-test
+        dict metric -> {"mean", "std", "tests": [per-test values], "ci95": [low, high],
+        "episodes": [per-episode values]}: std over tests, and a 95 % bootstrap interval of the
+        mean over the episodes themselves (:func:`interval95`; the episodes a metric counts,
+        kept so that the seeds of a zoo entry can be pooled: ``patrolsb3.zoo.pooled_result``), plus ``clean_episodes`` (per-test
         counts of episodes without a battery failure) and ``segments``.
     """
     failed = per_episode["failed"].reshape(tests, -1)                        # (T, N)
@@ -166,7 +167,9 @@ def summarize(per_episode: dict, tests: int) -> dict:
                       "std": float(np.nanstd(values)) if np.isfinite(values).any() else float("nan"),
                       "tests": [float(v) for v in values]}
         if episodes is not None:
+            episodes = np.asarray(episodes, dtype=np.float64)
             result["ci95"] = interval95(episodes)
+            result["episodes"] = [float(v) for v in episodes]    # what seeds are pooled from
         return result
 
     def clean_mean(x):
@@ -218,8 +221,10 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
         **env: other EnvConfig fields (e.g. p_dyn_max=0).
 
     Returns:
-        A JSON-friendly dict: the configuration, ``summary`` (see :func:`summarize`) and
-        ``bounds`` (:func:`idleness_lower_bounds`).
+        A JSON-friendly dict: the configuration (``env``: the simulator's, the paper's values for
+        the map; for a zoo model also ``policy_settings``, the observation, message and guard
+        settings it acts under, ``ZooPolicy.env_settings``), ``summary`` (see :func:`summarize`)
+        and ``bounds`` (:func:`idleness_lower_bounds`).
     """
     spec, cfg = evaluation_setup(map_name, n_agents, episodes, tests, steps, faults, **env)
     policy = load_policy(strategy, spec, n_agents, cfg, seed=seed, device=device)
@@ -229,8 +234,9 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
     per_episode = run_episodes(policy, spec, cfg, n_agents, tests * episodes, seed=seed,
                                progress=progress, desc=f"{strategy} map {spec.name} n={n_agents}",
                                deterministic=deterministic)
+    acts_under = {"policy_settings": policy.env_settings()} if hasattr(policy, "env_settings") else {}
     return {**request_of(strategy, spec, n_agents, episodes, tests, steps, seed, cfg, deterministic),
-            "summary": summarize(per_episode, tests),
+            **acts_under, "summary": summarize(per_episode, tests),
             "bounds": idleness_lower_bounds(spec.n_vertices, n_agents, steps)}
 
 
@@ -308,6 +314,7 @@ def write_zoo_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0
         results.append({"strategy": strategy, "map": config["map"], "n_agents": n, "episodes": episodes,
                         "tests": tests, "steps": steps, "seed": seed, "faults": [],
                         "deterministic": bool(deterministic), "env": cfg.to_dict(),
+                        "policy_settings": policy.env_settings(),
                         "summary": summarize(part, tests),
                         "bounds": idleness_lower_bounds(policy.spec.n_vertices, n, steps)})
     out = {"map": config["map"], "strategy": strategy, "episodes": episodes, "tests": tests,

@@ -146,7 +146,8 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
         r0 = results[0]
         spread = ("mean +- std over tests" if r0["tests"] > 1 else "one test") + \
             ", with a 95 % bootstrap interval over the episodes in brackets where the result has one " \
-            "(results computed before 2026-12-02 have none)"
+            "(results computed before 2026-12-02 have none; a zoo column that pools several training " \
+            "seeds bootstraps over all their episodes, see the notes below)"
         md += [f"{r0['tests']} test(s) x {r0['episodes']} episodes x {r0['steps']} steps per "
                f"(map, strategy, team size); {spread}. Idleness and collision figures "
                f"average over episodes without a battery failure (counts in results.csv). The best "

@@ -571,9 +571,11 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
 
 
 def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, steps: int, seed: int,
-                  tests: int = 1, zoo_dir=None, deterministic: bool = True, guard: bool = False):
-    """The default entry's eval.json result for exactly this protocol and action mode, or None."""
-    path = entry_dir(map_name, variant, zoo_dir, guard=guard) / "eval.json"
+                  tests: int = 1, zoo_dir=None, deterministic: bool = True, guard: bool = False,
+                  training_seed: int | None = None):
+    """One entry's eval.json result for exactly this protocol and action mode, or None: the
+    default seed's, or ``training_seed``'s."""
+    path = entry_dir(map_name, variant, zoo_dir, seed=training_seed, guard=guard) / "eval.json"
     if not path.is_file():
         return None
     data = json.loads(path.read_text())
@@ -583,3 +585,51 @@ def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
         return None
     found = next((r for r in data.get("results", []) if r["n_agents"] == n_agents), None)
     return None if found is None else {**found, "strategy": strategy_name(variant, guard)}
+
+
+def pooled_result(map_name: str, variant: str, n_agents: int, episodes: int, steps: int, seed: int,
+                  tests: int = 1, zoo_dir=None, deterministic: bool = True):
+    """The paper-setting entry's figures pooled over its training seeds, from their eval.json.
+
+    Every seed whose eval.json holds this protocol and per-episode figures contributes its
+    episodes: each metric's mean is the mean over all of them (every seed has the same number of
+    episodes, so this is also the mean of the seeds' means when no episode is dropped) and its
+    95 % interval is scipy's bootstrap over them (:func:`patrolsb3.evaluate.interval95`), each
+    (seed, episode) one draw: the spread between seeds enters through the episodes, not as a
+    separate level. ``summary[metric]["tests"]`` holds the seeds' own means. With one usable seed
+    this is that seed's result unchanged.
+
+    Returns:
+        The result dict (like :func:`cached_result`) with ``training_seeds`` (the seeds pooled)
+        and ``unpooled_seeds`` (seeds left out: no eval.json for this protocol, or one written
+        before per-episode figures were stored), or None when no seed has such a result.
+    """
+    from .evaluate import interval95
+    usable, left_out = [], []
+    for k in seeds(map_name, variant, zoo_dir):
+        r = cached_result(map_name, variant, n_agents, episodes, steps, seed, tests, zoo_dir,
+                          deterministic, training_seed=k)
+        if r is not None and all("episodes" in v for v in r["summary"].values() if isinstance(v, dict) and "ci95" in v):
+            usable.append((k, r))
+        else:
+            left_out.append(k)
+    if not usable:
+        return None
+    if len(usable) == 1:
+        return {**usable[0][1], "training_seeds": [usable[0][0]], "unpooled_seeds": left_out}
+    first = usable[0][1]
+    summary = {}
+    for metric, value in first["summary"].items():
+        if isinstance(value, dict) and "episodes" in value:
+            pooled = np.concatenate([np.asarray(r["summary"][metric]["episodes"], dtype=np.float64)
+                                     for _, r in usable])                     # (seeds x episodes,)
+            seed_means = [float(r["summary"][metric]["mean"]) for _, r in usable]
+            finite = pooled[np.isfinite(pooled)]
+            summary[metric] = {"mean": float(finite.mean()) if len(finite) else float("nan"),
+                               "std": float(np.nanstd(seed_means)), "tests": seed_means,
+                               "ci95": interval95(pooled), "episodes": [float(v) for v in pooled]}
+        elif metric == "clean_episodes":
+            summary[metric] = [int(sum(r["summary"][metric])) for _, r in usable]
+        else:
+            summary[metric] = value
+    return {**first, "summary": summary, "training_seeds": [k for k, _ in usable], "unpooled_seeds": left_out}

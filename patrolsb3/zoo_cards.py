@@ -58,8 +58,8 @@ def card(entry: dict) -> str:
              f"- **budget**: {int(budget.get('timesteps', 0)):,} agent-steps (all stages), about "
              f"{simulator_steps(c, budget.get('timesteps', 0)):,} simulator steps of episodes, "
              f"{budget.get('cpu_hours', '?')} CPU hours; {PAPER_BUDGET}",
-             f"- **training seed**: {c.get('seed')} (each seed is its own entry; the tables of "
-             f"zoo/README.md pool them)", ""]
+             f"- **training seed**: {c.get('seed')} (each seed is its own entry; `patrolsb3 compare` "
+             f"pools the seeds of an entry)", ""]
     if ev:
         lines += ["## Evaluation", "",
                   f"{ev.get('tests')} test x {ev.get('episodes')} episodes x {ev.get('steps')} steps per "

@@ -336,6 +336,53 @@ def test_zoo_eval_rewrites_eval_json_with_intervals_and_the_card_shows_them(trai
     shutil.copytree(trained["root"] / "zoo", copy)
     assert main(["zoo", "eval", "ROOM", "rl-msg", "--zoo-dir", str(copy), "--episodes", "3", "--steps", "20"]) == 0
     entry = zoo.read_entry(copy / "ROOM" / "rl-msg" / "seed0")
-    assert "ci95" in entry["eval"]["results"][0]["summary"]["avg_idleness"]
+    avg = entry["eval"]["results"][0]["summary"]["avg_idleness"]
+    acts_under = entry["eval"]["results"][0]["policy_settings"]          # what the policy saw, recorded
+    assert acts_under["message_encoding"] == entry["config"]["env"].get("message_encoding", "scalar")
+    assert "ci95" in avg and len(avg["episodes"]) == 3 and np.mean(avg["episodes"]) == pytest.approx(avg["mean"])
     text = card(entry)
     assert "| 1 | " in text and " [" in text.split("| 1 | ", 1)[1].split("\n")[0]   # intervals in the table
+
+
+def fake_seed_eval(folder, seed, values, episodes_kept=True, episodes=10):
+    """A seed folder with a stand-in model and an eval.json for n = 1 whose AVG^h episodes are
+    ``values`` (no per-episode figures when ``episodes_kept`` is False)."""
+    import json
+    path = folder / f"seed{seed}"
+    path.mkdir(parents=True)
+    (path / "model.zip").write_bytes(b"")
+    metric = {"mean": float(np.mean(values)), "std": 0.0, "tests": [float(np.mean(values))],
+              "ci95": [float(min(values)), float(max(values))]}
+    if episodes_kept:
+        metric["episodes"] = [float(v) for v in values]
+    result = {"strategy": "zoo:rl-msg", "map": "A", "n_agents": 1, "episodes": episodes, "tests": 1,
+              "steps": 100, "seed": 0, "faults": [], "deterministic": True,
+              "summary": {"avg_idleness": metric, "clean_episodes": [len(values)]}}
+    (path / "eval.json").write_text(json.dumps({"episodes": episodes, "steps": 100, "seed": 0, "tests": 1,
+                                                "deterministic": True, "results": [result]}))
+
+
+def test_seeds_are_pooled_episode_by_episode_and_the_unusable_ones_named(tmp_path):
+    folder = tmp_path / "A" / "rl-msg"
+    low, high = np.linspace(10, 11, 10), np.linspace(20, 21, 10)      # seed 0 and seed 1: far apart
+    fake_seed_eval(folder, 0, low)
+    fake_seed_eval(folder, 1, high)
+    (folder / "default.yml").write_text("seed: 0\nchosen_by: test\n")
+    args = ("A", "rl-msg", 1, 10, 100, 0)
+    r = zoo.pooled_result(*args, zoo_dir=tmp_path)
+    s = r["summary"]["avg_idleness"]
+    assert r["training_seeds"] == [0, 1] and r["unpooled_seeds"] == []
+    assert s["mean"] == pytest.approx(np.concatenate([low, high]).mean())
+    assert s["tests"] == pytest.approx([low.mean(), high.mean()]) and len(s["episodes"]) == 20
+    # the interval spans the two seeds' spread, far wider than either seed's own
+    assert s["ci95"][0] < 16 < s["ci95"][1] and s["ci95"][1] - s["ci95"][0] > 3
+    assert r["summary"]["clean_episodes"] == [10, 10]
+    # a seed evaluated before per-episode figures were kept is left out, and said to be
+    fake_seed_eval(folder, 2, high, episodes_kept=False)
+    r = zoo.pooled_result(*args, zoo_dir=tmp_path)
+    assert r["training_seeds"] == [0, 1] and r["unpooled_seeds"] == [2]
+    # one usable seed: its own result unchanged; another protocol: nothing to reuse
+    fake_seed_eval(tmp_path / "A" / "rl-no-msg", 0, low)
+    one = zoo.pooled_result("A", "rl-no-msg", 1, 10, 100, 0, zoo_dir=tmp_path)
+    assert one["summary"]["avg_idleness"]["ci95"] == [10.0, 11.0] and one["training_seeds"] == [0]
+    assert zoo.pooled_result("A", "rl-msg", 1, 20, 100, 0, zoo_dir=tmp_path) is None

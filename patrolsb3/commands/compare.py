@@ -24,17 +24,28 @@ def parse_agents(text: str) -> list[int]:
     return sorted(sizes)
 
 
-def zoo_note(zoo, map_name: str, strategy: str, reused: bool) -> str:
-    """The report's line about a zoo column: its setting (behind the return guard or the paper's)
-    and whether its figures were reused from the entry's eval.json or computed now."""
+def zoo_note(zoo, map_name: str, strategy: str, reused: bool, pooled=None) -> str:
+    """The report's line about a zoo column: its setting (behind the return guard or the paper's),
+    which training seeds its figures are (pooled: ``(seeds pooled, seeds left out)``) and whether
+    they were reused from the entries' eval.json or computed now."""
     variant, guard = zoo.parse_strategy(strategy)
     folder = zoo.entry_dir(map_name, variant, guard=guard)
     config = zoo.read_entry(folder)["config"]
     guarded = bool((config.get("env") or {}).get("return_guard"))
     setting = ("behind the return guard (env.return_guard, ours: the heuristics' recharge rule as a "
                "shield)" if guarded else "the paper's setting (no return guard)")
-    which = "" if guard else f"training seed {config.get('seed', '?')} ({default_reason(zoo, map_name, variant)}), "
-    return f"{setting}; {which}figures {'reused from its eval.json' if reused else 'computed now'}"
+    if guard:
+        which = ""
+    elif pooled and len(pooled[0]) > 1:
+        which = (f"training seeds {', '.join(map(str, pooled[0]))} pooled (intervals over their episodes "
+                 f"together); ")
+    else:
+        shown = pooled[0][0] if pooled else config.get("seed", "?")
+        which = f"training seed {shown} ({default_reason(zoo, map_name, variant)}); "
+    if pooled and pooled[1]:
+        which += (f"seed{'s' if len(pooled[1]) > 1 else ''} {', '.join(map(str, pooled[1]))} left out (no "
+                  f"eval.json with per-episode figures for this protocol: 'patrolsb3 zoo eval'); ")
+    return f"{setting}; {which}figures {'reused from the eval.json' if reused else 'computed now'}"
 
 
 def default_reason(zoo, map_name: str, variant: str) -> str:
@@ -150,12 +161,19 @@ def run(args):
                           f"...,{absent[0]}:guarded)", flush=True)
         cells += [(m, name, n) for name in names for n in sizes]
     found, sources = {}, {}
+    pooled = {}                      # {(MAP, zoo strategy): (seeds pooled, seeds left out)}
     for m, name, n in cells:         # what a zoo entry's eval.json or results.json already holds
         r = None
         if zoo is not None and name.startswith("zoo:") and not args.rerun_zoo:
             variant, guard = zoo.parse_strategy(name)
-            r = zoo.cached_result(m, variant, n, args.episodes, args.steps, args.seed, args.tests,
-                                  deterministic=not args.stochastic, guard=guard)
+            if guard:
+                r = zoo.cached_result(m, variant, n, args.episodes, args.steps, args.seed, args.tests,
+                                      deterministic=not args.stochastic, guard=True)
+            else:                    # the paper's setting: every seed with this protocol, pooled
+                r = zoo.pooled_result(m, variant, n, args.episodes, args.steps, args.seed, args.tests,
+                                      deterministic=not args.stochastic)
+                if r is not None:
+                    pooled[(m.upper(), name)] = (r["training_seeds"], r["unpooled_seeds"])
             sources[(m, name, n)] = "  (from the zoo's eval.json; --rerun-zoo to run it)" if r else ""
         if r is None and not args.rerun and not name.startswith("zoo:"):
             spec, cfg = evaluation_setup(m, n, args.episodes, args.tests, args.steps)
@@ -182,7 +200,8 @@ def run(args):
         found[(m, name, n)] = r
         report_cell(r, name, n, f"  ({seconds:.1f} s)")
     results = [found[c] for c in cells]
-    zoo_notes = {(m.upper(), name): zoo_note(zoo, m, name, reused=bool(sources.get((m, name, n))))
+    zoo_notes = {(m.upper(), name): zoo_note(zoo, m, name, reused=bool(sources.get((m, name, n))),
+                                             pooled=pooled.get((m.upper(), name)))
                  for m, name, n in cells if name.startswith("zoo:")}
     curves = {}                      # {MAP: {variant (or variant:guarded): curve.csv}} of the zoo columns
     for m, name, n in cells:
