@@ -20,7 +20,7 @@ def test_the_site_builds_strictly(tmp_path):
                           env={**os.environ, "NO_MKDOCS_2_WARNING": "1"})
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert "EnvConfig" in (tmp_path / "site" / "environment" / "index.html").read_text()   # from the docstrings
-    assert (tmp_path / "site" / "zoo" / "A-rl-msg" / "index.html").is_file()
+    assert (tmp_path / "site" / "zoo" / "A-rl-msg-seed0" / "index.html").is_file()
 
 
 def test_the_readme_is_a_front_page():
