@@ -37,8 +37,8 @@ def zoo_note(zoo, map_name: str, strategy: str, reused: bool, pooled=None) -> st
     if guard:
         which = ""
     elif pooled and len(pooled[0]) > 1:
-        which = (f"training seeds {', '.join(map(str, pooled[0]))} pooled (intervals over their episodes "
-                 f"together); ")
+        which = (f"training seeds {', '.join(map(str, pooled[0]))} pooled (+- is the std of the seeds' "
+                 f"means, the interval is over all their episodes together); ")
     else:
         shown = pooled[0][0] if pooled else config.get("seed", "?")
         which = f"training seed {shown} ({default_reason(zoo, map_name, variant)}); "
