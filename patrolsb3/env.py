@@ -143,13 +143,15 @@ class PatrolParallelEnv(ParallelEnv):
         self.agents = self.possible_agents[:self.n_agents]
         self._last_info = None
         self.episode_collisions = 0
+        idle = self.core_state.idle[0]                                          # (V,)
+        self._idleness = float(idle.sum() / idle.size), float(idle.max())       # (mean, max) now
         self._decide(protocol.first_phase(self.cfg))
         return self._observations(), self._infos(None)
 
     def step(self, actions):
         """Apply one (message, move) action per agent; see the class docstring for phases."""
         act = np.zeros((1, self.cfg.max_agents, 2), dtype=np.int64)             # (1, A, 2)
-        act[..., 1] = STAY                                                     # slots not deployed
+        act[0, :, 1] = STAY                                                    # slots not deployed
         for i, name in enumerate(self.agents):
             if name in actions and actions[name] is not None:
                 act[0, i] = np.asarray(actions[name], dtype=np.int64).reshape(2)
@@ -166,7 +168,7 @@ class PatrolParallelEnv(ParallelEnv):
             return self._observations(), zeros, falses, dict(falses), self._infos(None)
         self.episode_collisions += int(info.collisions[0])
         self._last_info = info
-        rewards = {a: float(info.reward[0, i]) for i, a in enumerate(self.agents)}
+        rewards = dict(zip(self.agents, info.reward[0].tolist()))
         term = bool(info.terminated[0])
         trunc = bool(info.truncated[0]) and not term
         terminations = {a: term for a in self.agents}
@@ -199,9 +201,8 @@ class PatrolParallelEnv(ParallelEnv):
             falses = [False] * k
             collided = pushed = started = battery_failed = fault_failed = falses
             swap_battery = [-1.0] * k
-            idle = s.idle[0]
             collisions, team = 0, 0.0
-            mean_idleness, max_idleness = float(idle.sum() / idle.size), float(idle.max())
+            mean_idleness, max_idleness = self._idleness   # a message phase leaves the idleness as it is
         else:
             collided, pushed = info.collided[0].tolist(), info.pushed[0].tolist()
             started = info.swap_started[0].tolist()
@@ -210,6 +211,7 @@ class PatrolParallelEnv(ParallelEnv):
             battery_failed, fault_failed = info.battery_failed[0].tolist(), info.fault_failed[0].tolist()
             collisions, team = int(info.collisions[0]), float(info.team_patrol[0])
             mean_idleness, max_idleness = float(info.mean_idleness[0]), float(info.max_idleness[0])
+            self._idleness = mean_idleness, max_idleness
         out = {}
         for i, name in enumerate(self.agents):   # values in the order of INFO_KEYS
             row = masks[i]

@@ -7,9 +7,10 @@ import functools
 import numpy as np
 
 from .maps import STATION, STAY, MapSpec
-from .state import State
+from .state import ACTIVE, State
 
 _STAY_ONLY = np.array([False, False, False, False, True])   # (5,) the mask of an inactive slot
+_STAY_ONLY.flags.writeable = False
 WAIT_ALLOWANCE = 1.25
 """Extra factor on the trip home for steps spent waiting or yielding in traffic."""
 
@@ -35,12 +36,18 @@ def _blocked(spec: MapSpec, state: State, target: np.ndarray) -> np.ndarray:
         (E, A, K) bool.
     """
     pos, active = state.pos, state.active                      # (E, A)
-    cells = spec.kinds.size
-    row = np.arange(pos.shape[0])[:, None] * cells              # (E, 1) offset of each episode
-    occupancy = np.bincount((row + pos)[active], minlength=pos.shape[0] * cells)  # (E * H*W,)
-    own = active[..., None] & (target == pos[..., None])       # (E, A, K) the slot itself
-    others = occupancy[row[..., None] + target] - own          # occupants other than the slot
-    return (others > 0) & ~station_cells(spec)[target]
+    held = np.where(active, pos, -1)                           # (E, A) cells of active agents, -1 none
+    # (E, A, K, A): slot i's k-th target is the cell of another active slot j
+    taken = (target[..., None] == held[:, None, None, :]) & _others(pos.shape[1])
+    return taken.any(axis=-1) & ~station_cells(spec)[target]
+
+
+@functools.lru_cache(maxsize=16)
+def _others(n_slots: int) -> np.ndarray:
+    """(A, 1, A) bool, True where j != i: every slot but the observer itself."""
+    out = ~np.eye(n_slots, dtype=bool)[:, None, :]
+    out.flags.writeable = False
+    return out
 
 
 def return_threshold(spec: MapSpec, cfg) -> np.ndarray:
@@ -169,23 +176,41 @@ def composite_action_mask(spec: MapSpec, cfg, state: State, message_phase: bool,
         move_mask: (E, A, 5) :func:`action_mask` of ``state`` if already computed.
 
     Returns:
-        message (E, A, n_symbols) bool and move (E, A, 5) bool.
+        message (E, A, n_symbols) bool and move (E, A, 5) bool; a half that is the same for
+        every slot (silence only, Stay only) is a read-only array shared between calls.
     """
     move = action_mask(spec, state, cfg) if move_mask is None else move_mask  # (E, A, 5)
     E, A = state.pos.shape
-    message = np.zeros((E, A, cfg.n_symbols), dtype=bool)
     chooses_message = cfg.comm != "none" and (message_phase or cfg.message_timing == "delayed")
-    active = state.active
     if chooses_message:
+        message = np.empty((E, A, cfg.n_symbols), dtype=bool)
         if cfg.comm == "intention":
             message[..., :5] = move
+            message[..., 5:] = False
         else:
             message[...] = True
-        message[~active] = False
-        message[~active, 0] = True
+        inactive = state.status != ACTIVE                                      # (E, A)
+        message[inactive] = _only_first(cfg.n_symbols, 1, 1)[0, 0]
     else:
-        message[..., 0] = True
+        message = _only_first(cfg.n_symbols, E, A)
     if message_phase:
-        move = np.zeros_like(move)
-        move[..., STAY] = True
+        move = _stay_only(E, A)
     return message, move
+
+
+@functools.lru_cache(maxsize=64)
+def _only_first(size: int, n_envs: int, n_slots: int) -> np.ndarray:
+    """(n_envs, n_slots, size) read-only bool rows allowing index 0 only (silence)."""
+    out = np.zeros((n_envs, n_slots, size), dtype=bool)
+    out[..., 0] = True
+    out.flags.writeable = False
+    return out
+
+
+@functools.lru_cache(maxsize=64)
+def _stay_only(n_envs: int, n_slots: int) -> np.ndarray:
+    """(n_envs, n_slots, 5) read-only bool move masks allowing Stay only."""
+    out = np.zeros((n_envs, n_slots, 5), dtype=bool)
+    out[..., STAY] = True
+    out.flags.writeable = False
+    return out

@@ -78,19 +78,33 @@ def vector_size(cfg: EnvConfig) -> int:
     return VECTOR_SIZE + (LOCAL_IDLENESS_SIZE if cfg.local_idleness else 0)
 
 
+@functools.lru_cache(maxsize=64)
+def _home_tables(spec: MapSpec, drain_high: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per-cell parts of :func:`home_features` that depend on the map only.
+
+    Returns:
+        features (H*W, 7) float32: home distance, 0 (the margin, filled per slot), home
+        direction one-hot (5); reserve (H*W,) float64: steps home x ``drain_high``.
+    """
+    H, W = spec.shape
+    features = np.zeros((spec.kinds.size, 7), dtype=np.float32)
+    features[:, 0] = np.minimum(spec.steps_home / (H + W), 1.0)
+    features[:, 2:] = _ONE_HOT[spec.home_move]
+    reserve = spec.steps_home * drain_high
+    features.flags.writeable = reserve.flags.writeable = False
+    return features, reserve
+
+
 def home_features(spec: MapSpec, cfg: EnvConfig, state: State) -> np.ndarray:
     """Home distance, battery margin and home direction of every slot (see module docstring).
 
     Returns:
         (E, A, 7) float32, zeros for inactive slots.
     """
-    H, W = spec.shape
-    steps_home = spec.steps_home[state.pos]                                    # (E, A)
-    out = np.empty(state.pos.shape + (7,), dtype=np.float32)
-    out[..., 0] = np.minimum(steps_home / (H + W), 1.0)
-    margin = (state.battery - steps_home * cfg.drain[1]) / cfg.b_max               # (E, A)
+    features, reserve = _home_tables(spec, float(cfg.drain[1]))
+    out = features[state.pos]                                                  # (E, A, 7) a copy
+    margin = (state.battery - reserve[state.pos]) / cfg.b_max                  # (E, A)
     out[..., 1] = np.minimum(np.maximum(margin, -1.0), 1.0)
-    out[..., 2:] = _ONE_HOT[spec.home_move[state.pos]]
     out[~state.active] = 0.0
     return out
 
@@ -145,12 +159,10 @@ def actor_observation(spec: MapSpec, cfg: EnvConfig, state: State, phase: int = 
     """
     E, A = state.pos.shape
     H, W = spec.shape
-    grid = np.zeros((E, A, grid_channels(cfg), H * W), dtype=np.float32)       # (E, A, C, H*W)
-    draw_positions(spec, cfg, state, grid)
-    f = normalised_idleness(state.idle, state.visited, cfg.c_norm)              # (E, V)
-    chan1 = np.repeat(_idleness_base(spec)[None], E, axis=0)                    # (E, H*W)
-    chan1[:, spec.vertex_cells] = f
-    grid[:, :, 1] = chan1[:, None, :]
+    grid = np.empty((E, A, grid_channels(cfg), H * W), dtype=np.float32)       # (E, A, C, H*W)
+    draw_positions(spec, cfg, state, grid)                                     # channels 0, 2 ..
+    grid[:, :, 1] = _idleness_base(spec)
+    grid[:, :, 1, spec.vertex_cells] = normalised_idleness(state.idle, state.visited, cfg.c_norm)[:, None]
 
     if mask is None:
         mask = action_mask(spec, state, cfg)
@@ -162,6 +174,7 @@ def actor_observation(spec: MapSpec, cfg: EnvConfig, state: State, phase: int = 
     vector[..., 7] = active
     vector[..., 8:VECTOR_SIZE] = home_features(spec, cfg, state)
     if cfg.local_idleness:
+        chan1 = grid[:, 0, 1]                                                  # (E, H*W) alike for all
         target = spec.neighbour[state.pos]                                     # (E, A, 5)
         local = np.take_along_axis(chan1, target.reshape(E, A * 5), axis=1).reshape(E, A, 5)
         local[~spec.move_ok[state.pos]] = -1.0                                 # off map, obstacle
@@ -180,7 +193,6 @@ def draw_positions(spec: MapSpec, cfg: EnvConfig, state: State, grid: np.ndarray
     """
     E, A = state.pos.shape
     planes = cfg.message_encoding == "planes"
-    kinds = spec.kinds.ravel()
     active = state.active                                                      # (E, A)
     if planes:   # positions at full scale; the symbols go to their own planes below
         own, other = np.ones((E, A)), np.full((E, A), OTHER_AGENT)             # (E, A) each
@@ -189,14 +201,14 @@ def draw_positions(spec: MapSpec, cfg: EnvConfig, state: State, grid: np.ndarray
         other = -own
     # what every observer sees of the others: agents off the station (active agents never
     # share a cell off the station, so no two writes collide)
-    shared = np.repeat(_position_base(spec, planes)[None], E, axis=0)         # (E, H*W)
-    drawn = active & (kinds != STATION)[state.pos]                             # (E, A)
+    grid[:, :, 0] = _position_base(spec, planes)
+    pos = state.pos
+    drawn = active & _off_station(spec)[pos]                                   # (E, A)
     e_d, j_d = np.nonzero(drawn)
-    shared[e_d, state.pos[e_d, j_d]] = other[e_d, j_d]
-    grid[:, :, 0] = shared[:, None, :]
+    grid[e_d, :, 0, pos[e_d, j_d]] = other[e_d, j_d, None]                     # every observer of e
     # each active observer sees itself positive on its own cell (station included)
     e_s, i_s = np.nonzero(active)
-    grid[e_s, i_s, 0, state.pos[e_s, i_s]] = own[e_s, i_s]
+    grid[e_s, i_s, 0, pos[e_s, i_s]] = own[e_s, i_s]
     if planes:
         grid[:, :, 2:] = 0.0
         _draw_symbol_planes(grid, state, drawn)
@@ -209,13 +221,27 @@ def critic_state(spec: MapSpec, cfg: EnvConfig, state: State) -> np.ndarray:
         (E, 3 * A) float32: battery fraction, row / (H-1), col / (W-1) of each slot.
     """
     E, A = state.pos.shape
-    H, W = spec.shape
     present = state.status == ACTIVE
     pos = np.where(present, state.pos, spec.station)
-    battery = np.where(present, state.battery / cfg.b_max, 1.0)
-    row, col = np.divmod(pos, W)
     out = np.empty((E, A, 3), dtype=np.float32)
-    out[..., 0] = battery
-    out[..., 1] = row / max(H - 1, 1)
-    out[..., 2] = col / max(W - 1, 1)
+    out[..., 0] = np.where(present, state.battery / cfg.b_max, 1.0)
+    out[..., 1:] = _cell_coordinates(spec)[pos]
     return out.reshape(E, 3 * A)
+
+
+@functools.lru_cache(maxsize=64)
+def _cell_coordinates(spec: MapSpec) -> np.ndarray:
+    """(H*W, 2) float32 row / (H-1) and col / (W-1) of every cell (the critic's positions)."""
+    H, W = spec.shape
+    row, col = np.divmod(np.arange(H * W), W)
+    out = np.stack([row / max(H - 1, 1), col / max(W - 1, 1)], axis=1).astype(np.float32)
+    out.flags.writeable = False
+    return out
+
+
+@functools.lru_cache(maxsize=64)
+def _off_station(spec: MapSpec) -> np.ndarray:
+    """(H*W,) bool, True on every cell but the stations."""
+    out = spec.kinds.ravel() != STATION
+    out.flags.writeable = False
+    return out

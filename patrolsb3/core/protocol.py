@@ -250,9 +250,12 @@ def check_actions(cfg: EnvConfig, phase: int, actions: np.ndarray, masks: np.nda
     actions = np.array(actions, dtype=np.int64)
     n = cfg.n_symbols
     message, move = actions[..., 0], actions[..., 1]
-    in_range = (message >= 0) & (message < n)
+    if phase != MESSAGE_PHASE and not message.any() and masks[..., 0].all():
+        return actions                   # silence everywhere, and silence is legal everywhere
+    in_range = message.view(np.uint64) < n                                   # negatives wrap to huge
     E, A = message.shape
-    message_ok = in_range & masks[np.arange(E)[:, None], np.arange(A), np.where(in_range, message, 0)]
+    chosen = np.where(in_range, message, 0).reshape(E * A)
+    message_ok = in_range & masks.reshape(E * A, -1)[np.arange(E * A), chosen].reshape(E, A)
     ok = message_ok & (move == STAY) if phase == MESSAGE_PHASE else message_ok
     if ok.all():
         return actions

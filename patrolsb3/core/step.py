@@ -66,7 +66,7 @@ class StepInfo:
 
 
 def check_moves(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
-                allowed: np.ndarray | None = None) -> np.ndarray:
+                allowed: np.ndarray | None = None, active: np.ndarray | None = None) -> np.ndarray:
     """Validate moves against the action mask.
 
     Args:
@@ -74,6 +74,7 @@ def check_moves(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
         allowed: (E, A, 5) bool, :func:`patrolsb3.core.masks.action_mask` of ``state`` without
             the return guard, when the caller already has it; else the rule is evaluated for
             the chosen moves only.
+        active: (E, A) bool ``state.active``, when the caller already has it.
 
     Returns:
         (E, A) int64 moves, invalid ones replaced by Stay when cfg.invalid_action == 'stay'.
@@ -87,11 +88,11 @@ def check_moves(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
     if (moves.view(np.uint64) > STAY).any():     # negative moves wrap to huge values
         bad = moves[(moves < 0) | (moves > STAY)][0]
         raise InvalidActionError(f"move {bad} outside 0..4 ({', '.join(ACTION_NAMES)})")
-    moves = np.where(state.active, moves, STAY)
+    moves = np.where(state.active if active is None else active, moves, STAY)
     if allowed is None:
         ok = move_allowed(spec, state, moves)                                 # (E, A)
     else:
-        ok = allowed.reshape(-1, allowed.shape[-1])[np.arange(moves.size), moves.ravel()].reshape(moves.shape)
+        ok = allowed.reshape(-1, allowed.shape[-1])[np.arange(moves.size), moves.reshape(-1)].reshape(moves.shape)
     if not ok.all():
         if cfg.invalid_action == "raise":
             e, a = np.argwhere(~ok)[0]
@@ -188,14 +189,14 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
     """
     rng = state.rng
     E, A = state.pos.shape
-    acted = state.active.copy()                                           # (E, A)
+    acted = state.active                                                  # (E, A) a new array
     # 1. messages
     if messages is not None:
         state.messages = np.where(acted, np.asarray(messages, dtype=np.int64), 0)
     else:
         state.messages = np.where(acted, state.messages, 0)
     # 2. moves, checked against the mask
-    moves = check_moves(spec, cfg, state, moves, allowed)
+    moves = check_moves(spec, cfg, state, moves, allowed, acted)
     pos = state.pos
     shaping = compute_reward and cfg.c_home > 0
     if shaping:
@@ -227,16 +228,16 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
     swapping = state.status == SWAPPING
     state.swap_left = np.where(swapping, state.swap_left - 1, state.swap_left)
     swap_ended = swapping & (state.swap_left <= 0)
-    state.status = np.where(swap_ended, ACTIVE, state.status).astype(np.int8)
+    state.status = np.where(swap_ended, ACTIVE, state.status).astype(np.int8, copy=False)
     state.battery = np.where(swap_ended, cfg.b_max, state.battery)
     arrived = acted & ~pushed & (new_pos != pos) & station_cells(spec)[new_pos]
     swap_battery = np.where(arrived, state.battery / cfg.b_max, np.nan)
-    state.status = np.where(arrived, SWAPPING, state.status).astype(np.int8)
+    state.status = np.where(arrived, SWAPPING, state.status).astype(np.int8, copy=False)
     durations = rng.integers(cfg.swap_time[0], cfg.swap_time[1] + 1, size=(E, A))
     state.swap_left = np.where(arrived, durations, state.swap_left)
     # 8. failures: empty battery, then injected faults
     battery_failed = acted & ~arrived & (state.battery <= 0)
-    state.status = np.where(battery_failed, FAILED, state.status).astype(np.int8)
+    state.status = np.where(battery_failed, FAILED, state.status).astype(np.int8, copy=False)
     fault_failed = _inject_faults(cfg, state, rng)
     # an agent saved by its arrival on the station did not fail: it gets the low-battery penalty
     reward_battery = (battery_reward(np.where(arrived, np.maximum(state.battery, 1e-9), state.battery), cfg)
@@ -267,13 +268,15 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
         swap_ended=swap_ended, battery_failed=battery_failed, fault_failed=fault_failed,
         team_patrol=team, mean_idleness=state.idle.sum(axis=1) / state.idle.shape[1],
         max_idleness=state.idle.max(axis=1), truncated=state.t >= cfg.episode_steps,
-        terminated=((state.status == FAILED) | (state.n_agents[:, None] <= np.arange(A))).all(axis=1))
+        terminated=(state.status >= FAILED).all(axis=1))   # every slot failed or absent (ABSENT > FAILED)
 
 
 def _inject_faults(cfg: EnvConfig, state: State, rng: np.random.Generator) -> np.ndarray:
     """Fail agents by schedule (cfg.faults) and by chance (cfg.fault_prob). Returns (E, A) bool."""
     E, A = state.pos.shape
     failed = np.zeros((E, A), dtype=bool)
+    if cfg.fault_prob <= 0 and not cfg.faults:
+        return failed
     if cfg.fault_prob > 0:
         failed |= (state.status == ACTIVE) & (rng.random((E, A)) < cfg.fault_prob)
     for fault_step, k in cfg.faults:
