@@ -207,6 +207,24 @@ def fault_tolerance(result: dict | None) -> dict:
     return {"verdict": HOLDS if ok else FAILS, "figure": figure, "cells": len(after)}
 
 
+def read_faults_result(path, argument: str = "--faults-result") -> dict:
+    """An ``evaluate --faults STEP:K --json`` result, for the claim on failing agents.
+
+    Raises:
+        ValueError: one line naming ``argument`` and the file: missing, or not such a result.
+    """
+    import json
+    path = Path(path)
+    try:
+        result = json.loads(path.read_text())
+        result["summary"]
+    except FileNotFoundError:
+        raise ValueError(f"{argument} {path}: no such file") from None
+    except (ValueError, KeyError, TypeError, UnicodeDecodeError):
+        raise ValueError(f"{argument} {path}: not an 'evaluate --json' result") from None
+    return result
+
+
 def claims(figures: dict, curves: dict | None = None, faults_result: dict | None = None) -> list[dict]:
     """One row per claim of the paper: {"claim", "figure", "verdict"} (module docstring)."""
     maps = sorted({k[0] for k in figures})

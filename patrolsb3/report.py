@@ -122,7 +122,7 @@ def clean_figures(summary: dict, precision: int = 1) -> str:
 
 
 def write_compare(results: list[dict], out_dir, plots: bool = True, learning_curves=None,
-                  zoo_notes: dict | None = None) -> list[Path]:
+                  zoo_notes: dict | None = None, faults_result: dict | None = None) -> list[Path]:
     """Write every table, the report and the plots of a comparison.
 
     Args:
@@ -133,6 +133,8 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
             (``<MAP>-training.png``) for maps that have any.
         zoo_notes: (map, strategy) -> a line about a zoo column (its setting and whether its
             figures were computed now or reused), printed in the report.
+        faults_result: an ``evaluate`` result with scheduled faults, for the claims table's
+            row on failing agents (:func:`patrolsb3.claims.read_faults_result`).
 
     Returns:
         The paths written.
@@ -212,7 +214,7 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
     written.append(long_path)
     if any(str(r.get("strategy", "")).startswith("zoo:") for r in results):   # the claims head the report
         from .claims import claims, claims_table, read_figures
-        rows = claims(read_figures(long_path), curves=learning_curves)
+        rows = claims(read_figures(long_path), curves=learning_curves, faults_result=faults_result)
         md[2:2] = ["## The paper's claims on these figures", "",
                    "One row per claim (`patrolsb3 claims`, which says how each verdict is reached).", "",
                    claims_table(rows), ""]

@@ -1,6 +1,7 @@
 """patrolsb3.claims: verdicts from intervals (holds / does not hold / inconclusive), each claim's
 cells, and the command."""
 import csv
+import json
 
 import pytest
 
@@ -101,6 +102,17 @@ def test_the_command_on_a_comparison_and_its_refusals(tmp_path, capsys):
     assert "no results.csv" in capsys.readouterr().err
     assert cli.main(["claims", str(tmp_path / "c"), "--faults-result", str(tmp_path / "c" / "report.md")]) == 2
     assert "not an 'evaluate --json' result" in capsys.readouterr().err
+    # compare takes the fault run too, so that the report's table has that row; a bad file
+    # stops it before any work, naming the argument
+    assert cli.main(common[:-1] + [str(tmp_path / "d"), "--faults-result", str(tmp_path / "none.json")]) == 2
+    assert "--faults-result" in capsys.readouterr().err and not (tmp_path / "d").exists()
+    faults = {"strategy": "SEBS", "map": "A", "n_agents": 3, "faults": [[20, 1]],
+              "summary": {"segments": [{"start": 0, "end": 21, "max_idleness": {"mean": 20.0}},
+                                       {"start": 21, "end": 60, "max_idleness": {"mean": 30.0}}]}}
+    (tmp_path / "faults.json").write_text(json.dumps(faults))
+    assert cli.main(common[:-1] + [str(tmp_path / "d"), "--faults-result", str(tmp_path / "faults.json")]) == 0
+    row = [l for l in (tmp_path / "d" / "report.md").read_text().splitlines() if "agents fail" in l][0]
+    assert "SEBS on A, n=3" in row and "**holds**" in row
 
 
 def test_claims_on_the_guarded_entries_only_when_asked(tmp_path, capsys):

@@ -14,11 +14,8 @@ def add_arguments(parser):
 
 
 def run(args):
-    import json
-    from pathlib import Path
-
     from .. import zoo
-    from ..claims import claims, claims_table, read_figures
+    from ..claims import claims, claims_table, read_faults_result, read_figures
     from ..outputs import check_output_file, write_json
     if args.json:
         check_output_file(args.json, "--json")
@@ -28,16 +25,7 @@ def run(args):
         figures = {(m, n, name.removesuffix(suffix), metric): f for (m, n, name, metric), f in figures.items()
                    if name.endswith(suffix) or not name.startswith("zoo:")
                    or not any(k[2] == name + suffix for k in figures)}
-    faults = None
-    if args.faults_result:
-        path = Path(args.faults_result)
-        try:
-            faults = json.loads(path.read_text())
-            faults["summary"]
-        except FileNotFoundError:
-            raise ValueError(f"--faults-result {path}: no such file") from None
-        except (ValueError, KeyError, TypeError):
-            raise ValueError(f"--faults-result {path}: not an 'evaluate --json' result") from None
+    faults = read_faults_result(args.faults_result) if args.faults_result else None
     curves = {m: {v: p for v in zoo.VARIANT_NAMES
                   if zoo.available(m, v, args.zoo_dir, guard=args.guarded)
                   and (p := zoo.entry_dir(m, v, args.zoo_dir, guard=args.guarded) / "curve.csv").is_file()}

@@ -97,6 +97,9 @@ def add_arguments(parser):
     parser.add_argument("--address", default=None,
                         help="with --ray: the Ray cluster to join (HOST:6379, or auto); default: start Ray "
                              "on this machine with its cores")
+    parser.add_argument("--faults-result", metavar="FILE", default=None,
+                        help="an 'evaluate --faults STEP:K --json' result: the claims table at the head "
+                             "of the report then tests the claim on failing agents too")
     parser.add_argument("--rerun-zoo", action="store_true",
                         help="evaluate zoo models again even when their eval.json already holds this "
                              "exact protocol (episodes, steps, seed, tests, action mode)")
@@ -112,6 +115,8 @@ def run(args):
     torch_device(args.device)   # a device torch cannot use: one line, before any work
     from ..outputs import check_output_dir
     check_output_dir(args.out, "--out")
+    from ..claims import read_faults_result
+    faults = read_faults_result(args.faults_result) if args.faults_result else None
     if args.protocol == "paper":
         args.tests, args.episodes, args.steps = 10, 100, 14400
     maps = [m.strip() for m in args.maps.split(",") if m.strip()]
@@ -209,6 +214,7 @@ def run(args):
             variant, guard = zoo.parse_strategy(name)
             if (path := zoo.entry_dir(m, variant, guard=guard) / "curve.csv").is_file():
                 curves.setdefault(m.upper(), {})[name[4:]] = path
-    paths = write_compare(results, args.out, learning_curves=curves, zoo_notes=zoo_notes)
+    paths = write_compare(results, args.out, learning_curves=curves, zoo_notes=zoo_notes,
+                          faults_result=faults)
     print(f"wrote {len(paths)} files to {args.out} (report: {args.out}/report.md)")
     return 0
