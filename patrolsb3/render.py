@@ -355,9 +355,27 @@ def trailing_mean(values: np.ndarray, window: int) -> np.ndarray:
     return (csum[idx] - csum[start]) / (idx - start)
 
 
+def training_axis(data: dict) -> tuple[np.ndarray, np.ndarray, str]:
+    """The x axis of a learning curve, and the row order along it.
+
+    Variants are compared at equal *simulator* steps (rl-no-msg has one decision per step,
+    rl-msg and rl-intention two), so the axis is the simulator steps of the training episodes
+    finished so far (the cumulative ``sim_steps`` column, rows in ``timesteps`` order); a curve
+    without that column falls back to agent-steps.
+
+    Returns:
+        order (N,) int row order, x (N,) float, and the axis label.
+    """
+    order = np.argsort(data["timesteps"], kind="stable")
+    if "sim_steps" in data:
+        return order, np.cumsum(data["sim_steps"][order]), "simulator steps of finished training episodes"
+    return order, data["timesteps"][order], "agent-steps"
+
+
 def plot_learning_curves(curves: dict, path, title: str = "", window: int = 50) -> Path:
     """The paper's training figure: episode return (cumulative team reward per episode),
-    smoothed over the last ``window`` episodes, against agent-steps, one line per variant.
+    smoothed over the last ``window`` episodes, against simulator steps (:func:`training_axis`),
+    one line per variant.
 
     Args:
         curves: label -> path of a curve.csv.
@@ -372,13 +390,15 @@ def plot_learning_curves(curves: dict, path, title: str = "", window: int = 50) 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6, 3.6), dpi=100)
+    xlabels = set()
     for label, csv_path in curves.items():
         data = read_curve(csv_path)
         if not data:
             continue
-        order = np.argsort(data["timesteps"], kind="stable")
-        ax.plot(data["timesteps"][order], trailing_mean(data["reward"][order], window), label=label)
-    ax.set_xlabel("agent-steps")
+        order, x, xlabel = training_axis(data)
+        xlabels.add(xlabel)
+        ax.plot(x, trailing_mean(data["reward"][order], window), label=label)
+    ax.set_xlabel(" / ".join(sorted(xlabels)) or "agent-steps")
     ax.set_ylabel(f"episode reward (mean of last {window})")
     ax.set_title(title)
     ax.grid(alpha=0.3)

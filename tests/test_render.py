@@ -150,3 +150,14 @@ def test_learning_curve_figure_is_written(tmp_path):
     assert read_curve(csv_path)["reward"].tolist() == [-5, -3, -1]
     out = plot_learning_curves({"rl-msg": csv_path}, tmp_path / "lc.png", title="A")
     assert out.stat().st_size > 1000
+
+
+def test_learning_curves_are_drawn_against_simulator_steps():
+    from patrolsb3.render import training_axis
+    # rows as episodes end (not in timesteps order); sim_steps is each episode's length
+    data = {"timesteps": np.array([300.0, 100.0, 200.0]), "reward": np.array([3.0, 1.0, 2.0]),
+            "sim_steps": np.array([30.0, 10.0, 20.0])}
+    order, x, label = training_axis(data)
+    assert order.tolist() == [1, 2, 0] and x.tolist() == [10, 30, 60] and label.startswith("simulator")
+    del data["sim_steps"]
+    assert training_axis(data)[1].tolist() == [100, 200, 300] and training_axis(data)[2] == "agent-steps"
