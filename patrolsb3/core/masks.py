@@ -194,7 +194,7 @@ def composite_action_mask(spec: MapSpec, cfg, state: State, message_phase: bool,
     else:
         message = _only_first(cfg.n_symbols, E, A)
     if message_phase:
-        move = _stay_only(E, A)
+        move = _stay_only_masks(E, A)
     return message, move
 
 
@@ -208,7 +208,7 @@ def _only_first(size: int, n_envs: int, n_slots: int) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=64)
-def _stay_only(n_envs: int, n_slots: int) -> np.ndarray:
+def _stay_only_masks(n_envs: int, n_slots: int) -> np.ndarray:
     """(n_envs, n_slots, 5) read-only bool move masks allowing Stay only."""
     out = np.zeros((n_envs, n_slots, 5), dtype=bool)
     out[..., STAY] = True
