@@ -18,7 +18,7 @@ def normalised_idleness(idle: np.ndarray, visited: np.ndarray, c_norm: float) ->
     Returns:
         (..., V) float values in [0, 1].
     """
-    return np.where(visited, -np.expm1(-idle / c_norm), 1.0)
+    return np.where(visited, -np.expm1(idle / -c_norm), 1.0)   # (-i) / c: the same bits as i / (-c)
 
 
 def team_patrol_reward(f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -62,6 +62,8 @@ def battery_reward(battery: np.ndarray, cfg: EnvConfig) -> np.ndarray:
         (E, A) penalty (<= 0).
     """
     b_l = cfg.b_low
+    if not (battery <= b_l).any():
+        return np.zeros(battery.shape)
     low = -(cfg.c_pbb + cfg.c_pbm * (b_l - battery) / b_l)
     return np.where(battery <= 0, -cfg.c_pb, np.where(battery <= b_l, low, 0.0))
 

@@ -25,6 +25,7 @@ Documented choices (where the paper is silent):
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
 
@@ -91,8 +92,8 @@ def check_moves(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
     moves = np.where(state.active if active is None else active, moves, STAY)
     if allowed is None:
         ok = move_allowed(spec, state, moves)                                 # (E, A)
-    else:
-        ok = allowed.reshape(-1, allowed.shape[-1])[np.arange(moves.size), moves.reshape(-1)].reshape(moves.shape)
+    else:   # allowed[e, a, moves[e, a]] through the flat view: one index array, not two
+        ok = allowed.reshape(-1)[_row_starts(moves.size) + moves.reshape(-1)].reshape(moves.shape)
     if not ok.all():
         if cfg.invalid_action == "raise":
             e, a = np.argwhere(~ok)[0]
@@ -103,6 +104,15 @@ def check_moves(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
                 f"set invalid_action='stay' to treat masked moves as Stay")
         moves = np.where(ok, moves, STAY)
     return moves
+
+
+@functools.lru_cache(maxsize=64)
+def _row_starts(n_rows: int) -> np.ndarray:
+    """(n_rows,) int64 0, 5, 10, ...: where each slot's row of an (E, A, 5) mask starts in its
+    flat view; read-only, one per size."""
+    out = np.arange(0, 5 * n_rows, 5, dtype=np.int64)
+    out.flags.writeable = False
+    return out
 
 
 def _no_conflict(spec: MapSpec, pos: np.ndarray, target: np.ndarray, active: np.ndarray,
@@ -205,12 +215,15 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
     # 3. pushes by the environment
     pushed = acted & (rng.random((E, A)) < state.p_dyn)
     push_dir = rng.integers(0, 4, size=(E, A))
-    target = np.where(pushed, spec.neighbour[pos, push_dir], spec.neighbour[pos, moves])
+    target = spec.neighbour[pos, moves]                                     # (E, A)
+    if pushed.any():
+        target = np.where(pushed, spec.neighbour[pos, push_dir], target)
     # 4. collisions
     new_pos, collided, collisions = resolve_collisions(spec, pos, target, acted, rng)
     # 5. battery
     drain = rng.uniform(cfg.drain[0], cfg.drain[1], size=(E, A))
-    drain = np.where(pushed, drain * cfg.push_drain_factor, drain)
+    if pushed.any():
+        drain = np.where(pushed, drain * cfg.push_drain_factor, drain)
     state.battery = np.where(acted, state.battery - drain, state.battery)
     # 6. idleness: grows by the rate, reset where active agents stand
     state.idle += spec.rate
@@ -225,24 +238,33 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
     state.visited[e_on, v_at[e_on, a_on]] = True
     state.pos = new_pos
     # 7. hot swaps: running swaps count down, then new arrivals on purpose start one
-    swapping = state.status == SWAPPING
-    state.swap_left = np.where(swapping, state.swap_left - 1, state.swap_left)
-    swap_ended = swapping & (state.swap_left <= 0)
-    state.status = np.where(swap_ended, ACTIVE, state.status).astype(np.int8, copy=False)
-    state.battery = np.where(swap_ended, cfg.b_max, state.battery)
+    # (each block below is skipped when its mask is all False: the same arrays come out)
+    swap_ended = swapping = state.status == SWAPPING                      # (E, A)
+    if swapping.any():
+        state.swap_left = np.where(swapping, state.swap_left - 1, state.swap_left)
+        swap_ended = swapping & (state.swap_left <= 0)
+        state.status = np.where(swap_ended, ACTIVE, state.status).astype(np.int8, copy=False)
+        state.battery = np.where(swap_ended, cfg.b_max, state.battery)
     arrived = acted & ~pushed & (new_pos != pos) & station_cells(spec)[new_pos]
-    swap_battery = np.where(arrived, state.battery / cfg.b_max, np.nan)
-    state.status = np.where(arrived, SWAPPING, state.status).astype(np.int8, copy=False)
     durations = rng.integers(cfg.swap_time[0], cfg.swap_time[1] + 1, size=(E, A))
-    state.swap_left = np.where(arrived, durations, state.swap_left)
+    if arrived.any():
+        swap_battery = np.where(arrived, state.battery / cfg.b_max, np.nan)
+        state.status = np.where(arrived, SWAPPING, state.status).astype(np.int8, copy=False)
+        state.swap_left = np.where(arrived, durations, state.swap_left)
+        battery_left = np.where(arrived, np.maximum(state.battery, 1e-9), state.battery)
+    else:
+        swap_battery = np.full((E, A), np.nan)
+        battery_left = state.battery
     # 8. failures: empty battery, then injected faults
-    battery_failed = acted & ~arrived & (state.battery <= 0)
-    state.status = np.where(battery_failed, FAILED, state.status).astype(np.int8, copy=False)
+    battery_failed = empty = state.battery <= 0                           # (E, A)
+    if empty.any():
+        battery_failed = acted & ~arrived & empty
+        state.status = np.where(battery_failed, FAILED, state.status).astype(np.int8, copy=False)
     fault_failed = _inject_faults(cfg, state, rng)
     # an agent saved by its arrival on the station did not fail: it gets the low-battery penalty
-    reward_battery = (battery_reward(np.where(arrived, np.maximum(state.battery, 1e-9), state.battery), cfg)
-                      if compute_reward else None)
-    state.battery = np.maximum(state.battery, 0.0)
+    reward_battery = battery_reward(battery_left, cfg) if compute_reward else None
+    if empty.any():
+        state.battery = np.maximum(state.battery, 0.0)
     state.t += 1
     # rewards
     if compute_reward:
@@ -252,7 +274,8 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
         d = difference_reward(f_without_k, on_vertex, mean_f, max_f, spec.n_vertices)
         reward_patrol = np.where(acted, cfg.c_rp * team[:, None] + cfg.difference_weight * d, 0.0)
         reward_battery = np.where(acted, reward_battery, 0.0)
-        reward_collision = np.where(acted, collision_reward(collided, cfg), 0.0)
+        reward_collision = (np.where(acted, collision_reward(collided, cfg), 0.0) if collisions.any()
+                            else np.zeros((E, A)))
         reward_home = np.zeros((E, A))
         if shaping:
             phi_after = home_potential(spec.steps_home[state.pos], state.battery, cfg, home_scale)
