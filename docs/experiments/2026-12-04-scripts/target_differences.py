@@ -1,0 +1,34 @@
+# Usage: python target_differences.py MAP [ZOO_SEED]: the AVG^h and MAX^h targets on one map,
+# as bootstrap intervals of the difference of means (zoo:rl-msg minus a heuristic), from
+# zoo/comparison/results.json (heuristics) and zoo/MAP/rl-msg/seed<ZOO_SEED>/eval.json (default 0).
+# scipy.stats.bootstrap, percentile method, 10,000 resamples, random_state 0; run from the repo root.
+import json, sys
+import numpy as np
+from scipy.stats import bootstrap
+
+MAP = sys.argv[1]
+SEED = sys.argv[2] if len(sys.argv) > 2 else "0"
+heuristics = json.load(open("zoo/comparison/results.json"))
+learned = json.load(open(f"zoo/{MAP}/rl-msg/seed{SEED}/eval.json"))["results"]
+
+
+def episodes(results, n, metric, strategy=None):
+    for r in results:
+        if r["n_agents"] == n and (strategy is None or (r["map"], r["strategy"]) == (MAP, strategy)):
+            return np.asarray(r["summary"][metric]["episodes"], float)
+    raise SystemExit(f"no result for {strategy or 'zoo:rl-msg'} n={n} on map {MAP}")
+
+
+def difference(a, b):
+    ci = bootstrap((a, b), lambda x, y, axis: x.mean(axis) - y.mean(axis), vectorized=True,
+                   random_state=0, method="percentile", n_resamples=10_000).confidence_interval
+    return f"{a.mean() - b.mean():+.1f} [{ci.low:+.1f}, {ci.high:+.1f}]"
+
+
+for n in range(2, 6):
+    print(f"n={n} AVG^h rl-msg - CR:", difference(episodes(learned, n, "avg_idleness"),
+                                                   episodes(heuristics, n, "avg_idleness", "CR")))
+for n in range(3, 6):
+    for h in ("CR", "PART", "SEBS"):
+        print(f"n={n} MAX^h rl-msg - {h}:", difference(episodes(learned, n, "max_idleness"),
+                                                        episodes(heuristics, n, "max_idleness", h)))
