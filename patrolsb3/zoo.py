@@ -209,8 +209,12 @@ def list_entries(zoo_dir=None) -> list[dict]:
 
 
 def available(map_name: str, variant: str, zoo_dir=None, guard: bool = False) -> bool:
-    """True when the zoo has a model for (map, variant) in that setting; False also when there is no zoo."""
+    """True when the zoo has a model for (map, variant) in that setting (in the paper's setting:
+    at least one trained seed, whether or not a default has been chosen among several; ask
+    :func:`default_seed` for that); False also when there is no zoo."""
     try:
+        if not guard:
+            return bool(seeds(map_name, variant, zoo_dir))
         return (entry_dir(map_name, variant, zoo_dir, guard=guard) / "model.zip").is_file()
     except ZooError:
         return False

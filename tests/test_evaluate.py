@@ -160,6 +160,24 @@ def test_compare_refuses_bad_strategies_before_running(tmp_path):
     assert cells[1] != "" and cells[3] != ""          # CR and SEBS columns filled from lower-case names
 
 
+def test_compare_asks_for_a_default_seed_before_running(tmp_path, monkeypatch, capsys):
+    # an entry with two trained seeds and no default.yml is a zoo column, not a missing one:
+    # compare stops at once and says how to choose the default (the seeds' figures are pooled,
+    # the default's config and training curve label the column)
+    root = tmp_path / "zoo"
+    for k in (0, 1):
+        (root / "A" / "rl-no-msg" / f"seed{k}").mkdir(parents=True)
+        (root / "A" / "rl-no-msg" / f"seed{k}" / "model.zip").write_bytes(b"")
+    monkeypatch.setenv(zoo.ZOO_ENV, str(root))
+    assert zoo.available("A", "rl-no-msg") and not zoo.available("A", "rl-msg")
+    for strategies in ([], ["--strategies", "CR,zoo:rl-no-msg"]):
+        assert cli.main(["compare", "--maps", "A", "--agents", "1", "--episodes", "1", "--steps", "5",
+                         "--out", str(tmp_path / "o"), "--no-progress", *strategies]) == 2
+        err = capsys.readouterr().err.strip()
+        assert "seeds [0, 1] and no default.yml; run 'patrolsb3 zoo choose A rl-no-msg'" in err
+        assert len(err.splitlines()) == 1 and not (tmp_path / "o").exists()
+
+
 def test_summary_also_averages_over_every_episode():
     per_episode = {"failed": np.array([True, False, False, True]),
                    "battery_failures": np.array([1, 0, 0, 2]), "swaps": np.array([0, 1, 1, 0]),

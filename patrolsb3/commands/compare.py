@@ -165,6 +165,10 @@ def run(args):
                           f"columns stay empty (the entries behind the return guard: --strategies "
                           f"...,{absent[0]}:guarded)", flush=True)
         cells += [(m, name, n) for name in names for n in sizes]
+    for m, name in dict.fromkeys((m, name) for m, name, _ in cells if name.startswith("zoo:")):
+        variant, guard = zoo.parse_strategy(name)
+        if not guard:    # several seeds and no default.yml: one line saying how to choose, before any work
+            zoo.default_seed(m, variant)
     found, sources = {}, {}
     pooled = {}                      # {(MAP, zoo strategy): (seeds pooled, seeds left out)}
     for m, name, n in cells:         # what a zoo entry's eval.json or results.json already holds
