@@ -1,15 +1,21 @@
 # Usage: python target_differences.py MAP [ZOO_SEED]: the AVG^h and MAX^h targets on one map,
 # as bootstrap intervals of the difference of means (zoo:rl-msg minus a heuristic), from
-# zoo/comparison/results.json (heuristics) and zoo/MAP/rl-msg/seed<ZOO_SEED>/eval.json (default 0).
+# zoo/comparison/results.json (heuristics) and zoo/MAP/rl-msg/seed<ZOO_SEED>/eval.json, or without
+# ZOO_SEED the episodes of every trained seed pooled (patrolsb3.zoo.pooled_result, as compare does).
 # scipy.stats.bootstrap, percentile method, 10,000 resamples, random_state 0; run from the repo root.
 import json, sys
 import numpy as np
 from scipy.stats import bootstrap
 
 MAP = sys.argv[1]
-SEED = sys.argv[2] if len(sys.argv) > 2 else "0"
+SEED = sys.argv[2] if len(sys.argv) > 2 else None
 heuristics = json.load(open("zoo/comparison/results.json"))
-learned = json.load(open(f"zoo/{MAP}/rl-msg/seed{SEED}/eval.json"))["results"]
+if SEED is not None:
+    learned = json.load(open(f"zoo/{MAP}/rl-msg/seed{SEED}/eval.json"))["results"]
+else:   # the 24 h protocol of zoo/comparison: 10 episodes x 14,400 steps, seed 0, greedy
+    from patrolsb3 import zoo
+    learned = [zoo.pooled_result(MAP, "rl-msg", n, 10, 14400, 0) for n in range(1, 6)]
+    print("pooled training seeds:", learned[0]["training_seeds"])
 
 
 def episodes(results, n, metric, strategy=None):
