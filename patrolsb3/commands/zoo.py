@@ -47,7 +47,7 @@ def add_arguments(parser):
     p_val.add_argument("--seed", type=int, default=7, help="simulator seed (default 7; the zoo's eval uses 0)")
     p_val.add_argument("--last", type=int, default=None, help="only the newest N checkpoints")
     p_eval = sub.add_parser("eval", help="evaluate an entry again and rewrite its eval.json (1..max_agents "
-                                          "agents, with 95 % intervals over episodes)")
+                                          "agents, with 95 %% intervals over episodes)")
     p_eval.add_argument("map")
     p_eval.add_argument("variant")
     p_eval.add_argument("--zoo-dir", default=None)
