@@ -1,0 +1,53 @@
+# Usage: python battery_failures.py MAP SEED_OF_ENTRY [N_AGENTS] [EPISODES] [STEPS] [SIM_SEED]
+# Why does a zoo rl-msg entry run out of battery? Runs the entry greedily (the 24 h protocol's
+# env, simulator seed SIM_SEED, default 1: not the evaluation's seed 0) and, for every agent whose
+# battery runs out, looks back over its last 300 steps: how far from the station it died, the
+# last step at which it still had the battery to fly home (battery >= steps home x the highest
+# drain 1.1), whether it was heading home after that (steps home falling), and how often its move
+# was lost to a collision or to the wind in its last 100 steps. Run from the repository root.
+import sys
+import numpy as np
+from patrolsb3 import zoo
+from patrolsb3.core.state import reset_state
+from patrolsb3.core.step import step
+
+MAP, ENTRY_SEED = sys.argv[1], int(sys.argv[2])
+N = int(sys.argv[3]) if len(sys.argv) > 3 else 5
+EPISODES = int(sys.argv[4]) if len(sys.argv) > 4 else 4
+STEPS = int(sys.argv[5]) if len(sys.argv) > 5 else 14400
+SIM_SEED = int(sys.argv[6]) if len(sys.argv) > 6 else 1
+LOOK = 300
+
+policy = zoo.load(MAP, "rl-msg", seed=ENTRY_SEED)
+spec, cfg = policy.spec, zoo.evaluation_config(policy, STEPS)
+home = spec.steps_home                                        # (H*W,) steps to the station
+sim = reset_state(spec, cfg, np.full(EPISODES, N), n_envs=EPISODES, seed=SIM_SEED)
+E, A = sim.pos.shape
+hist_home = np.zeros((LOOK, E, A), np.int64)                  # ring buffers over the last LOOK steps
+hist_batt = np.zeros((LOOK, E, A))
+hist_lost = np.zeros((LOOK, E, A), bool)                      # move lost: collided or pushed
+memory, start = None, np.ones(E, bool)
+deaths, swaps = [], 0
+for t in range(STEPS):
+    actions, memory = policy.predict(sim, state=memory, episode_start=start, deterministic=True)
+    start[:] = False
+    info = step(spec, cfg, sim, actions[..., 1], messages=actions[..., 0], compute_reward=False)
+    k = t % LOOK
+    hist_home[k], hist_batt[k] = home[sim.pos], sim.battery
+    hist_lost[k] = info.collided | info.pushed
+    swaps += int(info.swap_started.sum())
+    for e, a in zip(*np.nonzero(info.battery_failed)):
+        order = [(t - j) % LOOK for j in range(min(LOOK, t + 1))][::-1]    # oldest .. newest
+        h, b, lost = hist_home[order, e, a], hist_batt[order, e, a], hist_lost[order, e, a]
+        safe = np.nonzero(b >= 1.1 * h)[0]
+        last_safe = int(safe[-1]) if safe.size else -1
+        after = h[last_safe:] if last_safe >= 0 else h
+        deaths.append({"t": t, "episode": int(e), "steps_home_at_death": int(h[-1]),
+                       "steps_since_last_safe": len(h) - 1 - last_safe if last_safe >= 0 else None,
+                       "steps_home_at_last_safe": int(h[last_safe]) if last_safe >= 0 else None,
+                       "closer_after_last_safe": int(after[0] - after.min()),
+                       "moves_lost_last_100": int(lost[-100:].sum())})
+print(f"{MAP}/rl-msg seed {ENTRY_SEED}, {N} agents, {EPISODES} episodes x {STEPS} steps, "
+      f"simulator seed {SIM_SEED}: {len(deaths)} battery failures, {swaps} swaps")
+for d in deaths:
+    print(d)
