@@ -4,7 +4,8 @@
 # battery runs out, looks back over its last 300 steps: how far from the station it died, the
 # last step at which it still had the battery to fly home (battery >= steps home x the highest
 # drain 1.1), whether it was heading home after that (steps home falling), and how often its move
-# was lost to a collision or to the wind in its last 100 steps. Run from the repository root.
+# was lost to a collision or to the wind in its last 100 steps, and how long it had flown below
+# b_l (20 % of b_max: where the low-battery penalty starts). Run from the repository root.
 import sys
 import numpy as np
 from patrolsb3 import zoo
@@ -46,7 +47,10 @@ for t in range(STEPS):
                        "steps_since_last_safe": len(h) - 1 - last_safe if last_safe >= 0 else None,
                        "steps_home_at_last_safe": int(h[last_safe]) if last_safe >= 0 else None,
                        "closer_after_last_safe": int(after[0] - after.min()),
-                       "moves_lost_last_100": int(lost[-100:].sum())})
+                       "moves_lost_last_100": int(lost[-100:].sum()),
+                       "steps_below_b_l": int((b < cfg.b_low_frac * cfg.b_max).sum()),
+                       "battery_pct_100_before": round(100 * float(b[-100]) / cfg.b_max, 1)
+                       if len(b) >= 100 else None})
 print(f"{MAP}/rl-msg seed {ENTRY_SEED}, {N} agents, {EPISODES} episodes x {STEPS} steps, "
       f"simulator seed {SIM_SEED}: {len(deaths)} battery failures, {swaps} swaps")
 for d in deaths:
