@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 import zipfile
 from pathlib import Path
 
@@ -295,6 +296,39 @@ class RunFolder:
     def newest_model(self) -> Path | None:
         """``model.zip`` when the run finished, else its newest valid checkpoint, else None."""
         return self.model_file if self.model_file.is_file() else self.newest_checkpoint()
+
+    def snapshot(self, dest) -> Path:
+        """Copy what ``--resume`` needs into a new run folder ``dest``: the newest valid checkpoint
+        (the model with its optimizer state) and its reward statistics, config.yml, command.txt
+        and the CSV records; older checkpoints and TensorBoard logs are left behind. Used to
+        carry a stopped run to another machine (``zoo/snapshot_run.sh``).
+
+        Args:
+            dest: the snapshot's folder; replaced if it exists.
+
+        Returns:
+            The checkpoint copied, in ``dest``.
+
+        Raises:
+            FileNotFoundError: no valid checkpoint, or its statistics file is missing (names it).
+        """
+        checkpoint = self.newest_checkpoint()
+        if checkpoint is None:
+            raise FileNotFoundError(f"{self.path}: no valid checkpoint to snapshot")
+        steps = int(CHECKPOINT_RE.search(checkpoint.name).group(1))
+        statistics = self.statistics_file(steps)
+        if not statistics.is_file():
+            raise FileNotFoundError(f"{statistics}: missing (a checkpoint is resumed with its statistics)")
+        target = RunFolder(dest)
+        if target.path.exists():
+            shutil.rmtree(target.path)
+        target.create()
+        for source in (checkpoint, statistics):
+            shutil.copy2(source, target.checkpoints_dir / source.name)
+        for name in (self.CONFIG, self.COMMAND) + self.RECORDS:
+            if (self.path / name).is_file():
+                shutil.copy2(self.path / name, target.path / name)
+        return target.checkpoints_dir / checkpoint.name
 
     # -- config and command --------------------------------------------------------------------
     def read_config(self) -> dict:

@@ -38,6 +38,34 @@ def test_checkpoints_sort_by_steps_and_the_newest_valid_one_is_taken(tmp_path):
     assert run.newest_model() == run.checkpoint_file(1200)          # no model.zip: a stopped run
 
 
+def test_a_snapshot_holds_the_newest_valid_checkpoint_with_its_statistics_and_records(tmp_path):
+    import zipfile
+    run = RunFolder(tmp_path / "run")
+    run.create()
+    for steps in (400, 800):
+        with zipfile.ZipFile(run.checkpoint_file(steps), "w") as archive:
+            archive.writestr("data", "{}")
+        run.statistics_file(steps).write_bytes(b"stats %d" % steps)
+    run.checkpoint_file(1200).write_bytes(b"")                      # cut by a kill: passed over
+    run.config_file.write_text("map: A\n")
+    run.curve_file.write_text("timesteps\n400\n800\n")
+    run.tensorboard_dir.mkdir()
+    copied = run.snapshot(tmp_path / "snap")
+    snap = RunFolder(tmp_path / "snap")
+    assert copied == snap.checkpoint_file(800)
+    assert sorted(p.name for p in snap.checkpoints_dir.iterdir()) == ["model_800_steps.zip",
+                                                                      "model_vecnormalize_800_steps.pkl"]
+    assert snap.statistics_file(800).read_bytes() == b"stats 800"
+    assert sorted(p.name for p in snap.path.iterdir()) == ["checkpoints", "config.yml", "curve.csv"]
+    assert snap.newest_checkpoint() == snap.checkpoint_file(800)
+    run.statistics_file(800).unlink()
+    with pytest.raises(FileNotFoundError, match="model_vecnormalize_800_steps.pkl"):
+        run.snapshot(tmp_path / "snap2")
+    assert not (tmp_path / "snap2").exists()                        # refused before any copy
+    with pytest.raises(FileNotFoundError, match="no valid checkpoint"):
+        RunFolder(tmp_path / "empty").snapshot(tmp_path / "snap3")
+
+
 def test_config_is_written_and_read_through_the_schema(tmp_path):
     run = RunFolder(tmp_path)
     run.write_config({"map": "A", "seed": 3})
