@@ -315,8 +315,7 @@ class RunFolder:
         checkpoint = self.newest_checkpoint()
         if checkpoint is None:
             raise FileNotFoundError(f"{self.path}: no valid checkpoint to snapshot")
-        steps = int(CHECKPOINT_RE.search(checkpoint.name).group(1))
-        statistics = self.statistics_file(steps)
+        statistics = self.statistics_file(model_steps(checkpoint))
         if not statistics.is_file():
             raise FileNotFoundError(f"{statistics}: missing (a checkpoint is resumed with its statistics)")
         target = RunFolder(dest)
