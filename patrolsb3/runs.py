@@ -311,7 +311,13 @@ class RunFolder:
 
         Raises:
             FileNotFoundError: no valid checkpoint, or its statistics file is missing (names it).
+            FileExistsError: the run has finished (``model.zip``): it is not resumed, and a
+                snapshot would drop the older checkpoints that choosing one by validation reads.
         """
+        if self.model_file.is_file():
+            raise FileExistsError(
+                f"{self.path}: finished (model.zip), nothing to resume; a snapshot keeps one checkpoint, "
+                "so validate and export the run (zoo/finish_paper_run.sh) while its checkpoints are there")
         checkpoint = self.newest_checkpoint()
         if checkpoint is None:
             raise FileNotFoundError(f"{self.path}: no valid checkpoint to snapshot")

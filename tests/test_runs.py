@@ -66,6 +66,22 @@ def test_a_snapshot_holds_the_newest_valid_checkpoint_with_its_statistics_and_re
         RunFolder(tmp_path / "empty").snapshot(tmp_path / "snap3")
 
 
+def test_a_finished_run_is_not_snapshot_since_the_snapshot_would_drop_its_checkpoints(tmp_path):
+    import zipfile
+    run = RunFolder(tmp_path / "run")
+    run.create()
+    for steps in (400, 800):
+        with zipfile.ZipFile(run.checkpoint_file(steps), "w") as archive:
+            archive.writestr("data", "{}")
+        run.statistics_file(steps).write_bytes(b"stats")
+    run.snapshot(tmp_path / "stopped")                              # a stopped run: fine
+    with zipfile.ZipFile(run.model_file, "w") as archive:           # the run finishes
+        archive.writestr("data", "{}")
+    with pytest.raises(FileExistsError, match=r"finished \(model.zip\).*finish_paper_run"):
+        run.snapshot(tmp_path / "finished")
+    assert not (tmp_path / "finished").exists()                     # refused before any copy
+
+
 def test_config_is_written_and_read_through_the_schema(tmp_path):
     run = RunFolder(tmp_path)
     run.write_config({"map": "A", "seed": 3})

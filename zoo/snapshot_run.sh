@@ -19,5 +19,11 @@ OUT=${OUT:-runs/paper}
 RUN="$OUT/stage$STAGE/$MAP/$VARIANT/seed$SEED"
 DEST="zoo/in_progress/stage$STAGE/$MAP/$VARIANT/seed$SEED"
 [ -d "$RUN" ] || { echo "snapshot_run.sh: $RUN: no such run folder" >&2; exit 2; }
-python -c "import sys; from patrolsb3.runs import RunFolder; print(RunFolder(sys.argv[1]).snapshot(sys.argv[2]))" "$RUN" "$DEST"
+python -c "
+import sys
+from patrolsb3.runs import RunFolder
+try:
+    print(RunFolder(sys.argv[1]).snapshot(sys.argv[2]))
+except (FileNotFoundError, FileExistsError) as error:
+    sys.exit(f'snapshot_run.sh: {error}')" "$RUN" "$DEST"
 du -sh "$DEST"
