@@ -38,14 +38,20 @@ def test_checkpoints_sort_by_steps_and_the_newest_valid_one_is_taken(tmp_path):
     assert run.newest_model() == run.checkpoint_file(1200)          # no model.zip: a stopped run
 
 
-def test_a_snapshot_holds_the_newest_valid_checkpoint_with_its_statistics_and_records(tmp_path):
+def _stopped_run(path, steps) -> RunFolder:
+    """A run folder with a valid checkpoint and its statistics for each of ``steps``, no model.zip."""
     import zipfile
-    run = RunFolder(tmp_path / "run")
+    run = RunFolder(path)
     run.create()
-    for steps in (400, 800):
-        with zipfile.ZipFile(run.checkpoint_file(steps), "w") as archive:
+    for step in steps:
+        with zipfile.ZipFile(run.checkpoint_file(step), "w") as archive:
             archive.writestr("data", "{}")
-        run.statistics_file(steps).write_bytes(b"stats %d" % steps)
+        run.statistics_file(step).write_bytes(b"stats %d" % step)
+    return run
+
+
+def test_a_snapshot_holds_the_newest_valid_checkpoint_with_its_statistics_and_records(tmp_path):
+    run = _stopped_run(tmp_path / "run", steps=(400, 800))
     run.checkpoint_file(1200).write_bytes(b"")                      # cut by a kill: passed over
     run.config_file.write_text("map: A\n")
     run.curve_file.write_text("timesteps\n400\n800\n")
@@ -68,12 +74,7 @@ def test_a_snapshot_holds_the_newest_valid_checkpoint_with_its_statistics_and_re
 
 def test_a_finished_run_is_not_snapshot_since_the_snapshot_would_drop_its_checkpoints(tmp_path):
     import zipfile
-    run = RunFolder(tmp_path / "run")
-    run.create()
-    for steps in (400, 800):
-        with zipfile.ZipFile(run.checkpoint_file(steps), "w") as archive:
-            archive.writestr("data", "{}")
-        run.statistics_file(steps).write_bytes(b"stats")
+    run = _stopped_run(tmp_path / "run", steps=(400, 800))
     run.snapshot(tmp_path / "stopped")                              # a stopped run: fine
     with zipfile.ZipFile(run.model_file, "w") as archive:           # the run finishes
         archive.writestr("data", "{}")
