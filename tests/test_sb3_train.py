@@ -114,18 +114,22 @@ def test_hyperparameter_helpers():
 
 def test_learns_to_beat_random_on_a_corridor(tmp_path):
     env_kwargs = {"max_agents": 1, "episode_steps": 30, "p_dyn_max": 0.0}
-    # 24,000 steps: trained/random was 0.40-0.52 over seeds 0-3 (sb3 2.9.2); at 12,000 it was
-    # 0.60-0.82, too close to the 0.8 bar for a test that must not depend on library versions
-    run = train(map=CORRIDOR, variant="rl-no-msg", timesteps=24000, run_dir=tmp_path / "r", seed=0,
-                progress_bar=False,
-                hyperparams={"n_envs": 4, "curriculum": False, "n_steps": 60, "n_minibatches": 4, "n_epochs": 4,
-                             "learning_rate": 1e-3, "eval_freq": 0, "env": env_kwargs,
-                             "policy_kwargs": {"dense_sizes": [64, 64], "lstm_hidden_size": 32}})
-    model = MaskableRecurrentPPO.load(run / "model.zip", device="cpu")
+    # 24,000 steps: trained/random was 0.40-0.52 over seeds 0-3 (sb3 2.9.2, an Intel host); at
+    # 12,000 it was 0.60-0.82. On an AMD EPYC host (2026-12-06, same packages) seed 0 did not
+    # learn (1.05) while seeds 1 and 2 reached 0.49 and 0.53: one seed's run depends on the CPU's
+    # float kernels, so the test asks the median of three seeds to beat random by 20 %
     env = make_vec_env(CORRIDOR, agents=[1] * 8, variant="rl-no-msg", seed=5, **env_kwargs)
-    trained = np.mean([r["mean_idleness"] for r in evaluate(model, env)])
     random = np.mean([r["mean_idleness"] for r in evaluate(RandomMaskedPolicy(seed=1), env)])
-    assert trained < 0.8 * random, (trained, random)
+    ratios = []   # trained / random mean idleness, one per training seed
+    for seed in (0, 1, 2):
+        run = train(map=CORRIDOR, variant="rl-no-msg", timesteps=24000, run_dir=tmp_path / f"r{seed}",
+                    seed=seed, progress_bar=False,
+                    hyperparams={"n_envs": 4, "curriculum": False, "n_steps": 60, "n_minibatches": 4,
+                                 "n_epochs": 4, "learning_rate": 1e-3, "eval_freq": 0, "env": env_kwargs,
+                                 "policy_kwargs": {"dense_sizes": [64, 64], "lstm_hidden_size": 32}})
+        model = MaskableRecurrentPPO.load(run / "model.zip", device="cpu")
+        ratios.append(np.mean([r["mean_idleness"] for r in evaluate(model, env)]) / random)
+    assert np.median(ratios) < 0.8, ratios
 
 
 def test_reward_normalisation_saves_and_resumes_its_statistics(tmp_path):
