@@ -297,43 +297,56 @@ class RunFolder:
         """``model.zip`` when the run finished, else its newest valid checkpoint, else None."""
         return self.model_file if self.model_file.is_file() else self.newest_checkpoint()
 
-    def snapshot(self, dest) -> Path:
+    def snapshot(self, dest, keep: int = 1) -> Path:
         """Copy what ``--resume`` needs into a new run folder ``dest``: the newest valid checkpoint
         (the model with its optimizer state) and its reward statistics, config.yml, command.txt
-        and the CSV records; older checkpoints and TensorBoard logs are left behind. Used to
-        carry a stopped run to another machine (``zoo/snapshot_run.sh``).
+        and the CSV records; TensorBoard logs and, unless ``keep`` asks for them, older
+        checkpoints are left behind. Used to carry a stopped run to another machine
+        (``zoo/snapshot_run.sh``).
 
         Args:
             dest: the snapshot's folder; replaced if it exists.
+            keep: how many of the newest valid checkpoints to copy, each with its statistics
+                (default 1, all that ``--resume`` reads). A run stopped near its end keeps more,
+                so that choosing a checkpoint by validation (``zoo validate --last 6``) still
+                sees those written before the stop.
 
         Returns:
-            The checkpoint copied, in ``dest``.
+            The newest checkpoint copied, in ``dest``.
 
         Raises:
-            FileNotFoundError: no valid checkpoint, or its statistics file is missing (names it).
+            ValueError: ``keep`` is below 1.
+            FileNotFoundError: no valid checkpoint, or the statistics file of one to copy is
+                missing (names it).
             FileExistsError: the run has finished (``model.zip``): it is not resumed, and a
                 snapshot would drop the older checkpoints that choosing one by validation reads.
         """
+        if isinstance(keep, bool) or not isinstance(keep, int) or keep < 1:
+            raise ValueError(f"keep: {keep!r} is not a whole number of checkpoints >= 1")
         if self.model_file.is_file():
             raise FileExistsError(
-                f"{self.path}: finished (model.zip), nothing to resume; a snapshot keeps one checkpoint, "
+                f"{self.path}: finished (model.zip), nothing to resume; a snapshot keeps only the newest checkpoints, "
                 "so validate and export the run (zoo/finish_paper_run.sh) while its checkpoints are there")
-        checkpoint = self.newest_checkpoint()
-        if checkpoint is None:
+        kept = [p for p in reversed(self.checkpoints()) if is_valid_model_file(p)][:keep]
+        # kept: newest first, at most `keep` paths
+        if not kept:
             raise FileNotFoundError(f"{self.path}: no valid checkpoint to snapshot")
-        statistics = self.statistics_file(model_steps(checkpoint))
-        if not statistics.is_file():
-            raise FileNotFoundError(f"{statistics}: missing (a checkpoint is resumed with its statistics)")
+        sources = []
+        for checkpoint in kept:
+            statistics = self.statistics_file(model_steps(checkpoint))
+            if not statistics.is_file():
+                raise FileNotFoundError(f"{statistics}: missing (a checkpoint is resumed with its statistics)")
+            sources += [checkpoint, statistics]
         target = RunFolder(dest)
         if target.path.exists():
             shutil.rmtree(target.path)
         target.create()
-        for source in (checkpoint, statistics):
+        for source in sources:
             shutil.copy2(source, target.checkpoints_dir / source.name)
         for name in (self.CONFIG, self.COMMAND) + self.RECORDS:
             if (self.path / name).is_file():
                 shutil.copy2(self.path / name, target.path / name)
-        return target.checkpoints_dir / checkpoint.name
+        return target.checkpoints_dir / kept[0].name
 
     # -- config and command --------------------------------------------------------------------
     def read_config(self) -> dict:

@@ -72,6 +72,26 @@ def test_a_snapshot_holds_the_newest_valid_checkpoint_with_its_statistics_and_re
         RunFolder(tmp_path / "empty").snapshot(tmp_path / "snap3")
 
 
+def test_a_snapshot_keeps_the_newest_k_valid_checkpoints_when_asked(tmp_path):
+    run = _stopped_run(tmp_path / "run", steps=(400, 800, 1200, 1600))
+    run.checkpoint_file(2000).write_bytes(b"")                      # cut by a kill: passed over
+    copied = run.snapshot(tmp_path / "snap", keep=3)
+    snap = RunFolder(tmp_path / "snap")
+    assert copied == snap.checkpoint_file(1600)
+    assert [p.name for p in snap.checkpoints()] == [f"model_{s}_steps.zip" for s in (800, 1200, 1600)]
+    assert all(snap.statistics_file(s).read_bytes() == b"stats %d" % s for s in (800, 1200, 1600))
+    run.snapshot(tmp_path / "all", keep=10)                         # more than there are: all of them
+    assert len(RunFolder(tmp_path / "all").checkpoints()) == 4
+    run.statistics_file(800).unlink()
+    with pytest.raises(FileNotFoundError, match="model_vecnormalize_800_steps.pkl"):
+        run.snapshot(tmp_path / "snap2", keep=3)
+    assert not (tmp_path / "snap2").exists()                        # refused before any copy
+    for bad in (0, -1, 1.5, True):
+        with pytest.raises(ValueError, match="keep: "):
+            run.snapshot(tmp_path / "snap3", keep=bad)
+    assert not (tmp_path / "snap3").exists()
+
+
 def test_a_finished_run_is_not_snapshot_since_the_snapshot_would_drop_its_checkpoints(tmp_path):
     import zipfile
     run = _stopped_run(tmp_path / "run", steps=(400, 800))
