@@ -5,7 +5,9 @@ command that continues it from a fresh clone. Run from the repository root after
     python zoo/in_progress_table.py > /tmp/table.md     # then paste it into the README
 
 A stage-2 snapshot (a ``checkpoints/`` folder) is continued with ``--resume``; a finished
-stage-1 run (a ``model.zip``) starts its stage 2. CPU hours come from the run's cpu_time.csv.
+stage-1 run (a ``model.zip``) starts its stage 2. CPU hours come from the run's cpu_time.csv;
+the hours left of a stage-2 run are estimated at its own pace so far (hosts differ), those of
+a stage 2 not yet started at CPU_PER_AGENT_STEP.
 """
 from __future__ import annotations
 
@@ -53,9 +55,12 @@ def row(run: Path) -> str:
     finish = f"`zoo/finish_paper_run.sh {map_name} {variant} {k}`"
     if (run / "checkpoints").is_dir():
         done = model_steps(RunFolder(run).newest_checkpoint())
-        left = (timesteps - done) * CPU_PER_AGENT_STEP / 3600
+        recorded_steps, hours = _last_record(run)
+        # the run's own pace where it has one (hosts differ by 1.6x), else the zoo's typical one
+        per_step = hours * 3600 / recorded_steps if recorded_steps else CPU_PER_AGENT_STEP
+        left = (timesteps - done) * per_step / 3600
         where = (f"{stage[:5]} {stage[5:]} stopped at **{done:,} of {timesteps:,}** agent-steps "
-                 f"({_last_record(run)[1]:.2f} CPU h so far), with its optimizer state")
+                 f"({hours:.2f} CPU h so far), with its optimizer state")
         how = f"`{copy} && {train} 2 SECONDS --resume` (~{left:.1f} CPU h left), then {finish}"
     else:
         stage2 = 16_000_000 if variant != "rl-no-msg" else 8_000_000
