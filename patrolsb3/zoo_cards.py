@@ -1,8 +1,10 @@
 """Model cards of the zoo's entries (``patrolsb3 zoo cards --out docs/zoo``): one markdown page
 per entry, in the spirit of the Hugging Face SB3 model cards (library, env, settings, budget,
-evaluation, usage), and an index of them."""
+evaluation, what its messages carry, usage), an index of them, and ``messages.md``: the
+listening and ablation figures of every entry that has them, side by side."""
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 from .report import ZOO_TABLE_METRICS, mean_std
@@ -38,6 +40,84 @@ def load_line(entry: dict) -> str:
         (f", seed={entry['seed']}" if entry.get("seed") is not None else "")
     return (f"policy = zoo.load({c.get('map')!r}, {c.get('variant')!r}{extra})        # evaluation: "
             f"--strategy {strategy_name(c.get('variant'), bool(entry.get('guard')))}")
+
+
+ABLATION_METRICS = (("avg_idleness", "AVG^h"), ("max_idleness", "MAX^h"), ("collisions", "collisions"))
+ABLATIONS = ("constant", "shuffled")
+
+
+def message_figures(entry: dict) -> tuple[dict | None, dict | None]:
+    """The entry's ``listening.json`` and ``ablation.json`` (written by ``zoo listening`` and
+    ``zoo ablation`` beside the model), each None where the entry has none."""
+    folder = Path(entry["path"])
+    found = []
+    for name in ("listening.json", "ablation.json"):
+        path = folder / name
+        found.append(json.loads(path.read_text()) if path.is_file() else None)
+    return found[0], found[1]
+
+
+def change_text(figure: dict) -> str:
+    """``+6.1 [+3.1, +8.8] *``: an ablation's change (ablated - as trained) with its 95 %
+    interval, starred when the interval excludes zero."""
+    low, high = figure["change_ci95"]
+    star = " *" if low > 0 or high < 0 else ""
+    return f"{figure['change']:+.1f} [{low:+.1f}, {high:+.1f}]{star}"
+
+
+def listening_cells(figures: dict) -> list[str]:
+    """KL, greedy change, symbols, entropy and the two mutual informations of ``listening.json``."""
+    return [f"{figures['kl_nats']:.3f}", f"{100 * figures['greedy_changed']:.1f} %",
+            f"{figures['symbols_used']} of 16", f"{figures['symbol_entropy_bits']:.2f}",
+            f"{figures['mi_own_move_bits']:.2f}", f"{figures['mi_others_moves_bits']:.2f}"]
+
+
+LISTENING_HEADER = ("| listening KL (nats) | greedy move changed | symbols used | symbol entropy (bits) | "
+                    "MI symbol ; own next move (bits) | MI symbol ; others' next moves (bits) |")
+
+
+def messages_section(entry: dict) -> list[str]:
+    """The card's "What its messages carry" section; empty when the entry has no figures."""
+    listening, ablation = message_figures(entry)
+    lines = []
+    if listening or ablation:
+        lines += ["## What its messages carry", ""]
+    if listening:
+        lines += [f"`patrolsb3 zoo listening` ({listening['n_agents']} agents, {listening['episodes']} "
+                  f"episodes x {listening['steps']} steps, seed {listening['seed']}):", "",
+                  LISTENING_HEADER, "|---" * 6 + "|", "| " + " | ".join(listening_cells(listening)) + " |", ""]
+    if ablation:
+        lines += [f"`patrolsb3 zoo ablation` ({ablation['n_agents']} agents, {ablation['episodes']} episodes "
+                  f"x {ablation['steps']} steps, seed {ablation['seed']}; change = ablated - as trained, "
+                  f"95 % interval of the paired difference, * where it excludes zero):", "",
+                  "| received | " + " | ".join(h for _, h in ABLATION_METRICS) + " |", "|---" * 4 + "|",
+                  "| as sent | " + " | ".join(f"{ablation['baseline'][k]:.1f}" for k, _ in ABLATION_METRICS) + " |"]
+        for kind in ABLATIONS:
+            lines.append(f"| {kind} | " + " | ".join(
+                f"{ablation[kind][k]['mean']:.1f} ({change_text(ablation[kind][k])})" for k, _ in ABLATION_METRICS) + " |")
+        lines.append("")
+    return lines
+
+
+def messages_page(entries: list[dict]) -> str:
+    """``messages.md``: one row per entry with listening figures, then one per entry with an
+    ablation, so that the seeds of every map can be read side by side."""
+    rows = [(entry_name(e), *message_figures(e)) for e in entries]
+    lines = ["# What the messages carry", "",
+             "Written by `patrolsb3 zoo cards` from the `listening.json` and `ablation.json` beside each "
+             "entry (`patrolsb3 zoo listening MAP VARIANT --seed-of-entry K`, `patrolsb3 zoo ablation ...`). "
+             "Listening: how much an agent's move distribution changes when the symbols it receives are "
+             "replaced by random ones. Ablation: the team's figures when the received symbols are a "
+             "constant or shuffled between agents; change = ablated - as trained, 95 % interval of the "
+             "paired difference, * where it excludes zero.", "",
+             "## Listening", "", "| entry " + LISTENING_HEADER, "|---" * 7 + "|"]
+    lines += [f"| {name} | " + " | ".join(listening_cells(lis)) + " |" for name, lis, _ in rows if lis]
+    lines += ["", "## Ablation", "",
+              "| entry | " + " | ".join(f"{kind}: {h}" for kind in ABLATIONS for _, h in ABLATION_METRICS) + " |",
+              "|---" * (1 + len(ABLATIONS) * len(ABLATION_METRICS)) + "|"]
+    lines += [f"| {name} | " + " | ".join(change_text(abl[kind][k]) for kind in ABLATIONS for k, _ in ABLATION_METRICS)
+              + " |" for name, _, abl in rows if abl]
+    return "\n".join(lines) + "\n"
 
 
 def card(entry: dict) -> str:
@@ -77,6 +157,7 @@ def card(entry: dict) -> str:
                 cells.append(mean_std(s.get(key) or {}, digits))
             lines.append(f"| {row['n_agents']} | " + " | ".join(cells) + " |")
         lines.append("")
+    lines += messages_section(entry)
     lines += ["## How to load it", "", "```python", "import patrolsb3",
               "from patrolsb3 import zoo", "from patrolsb3.agents import PettingZooAgent, play_episode", "",
               load_line(entry),
@@ -86,13 +167,15 @@ def card(entry: dict) -> str:
 
 
 def write_cards(out_dir, zoo_dir=None) -> list[Path]:
-    """Write one card per zoo entry and ``index.md`` into ``out_dir``; returns the paths."""
+    """Write one card per zoo entry, ``index.md`` and ``messages.md`` into ``out_dir``; returns
+    the paths."""
     from .zoo import list_entries
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    entries = list_entries(zoo_dir)
     written, index = [], ["# Model cards", "", "| entry | variant | setting | agent-steps | CPU h |",
                           "|---|---|---|---|---|"]
-    for entry in list_entries(zoo_dir):
+    for entry in entries:
         c = entry["config"]
         stem = entry_name(entry).replace("/", "-")
         path = out / f"{stem}.md"
@@ -102,5 +185,7 @@ def write_cards(out_dir, zoo_dir=None) -> list[Path]:
         budget = c.get("budget") or {}
         index.append(f"| [{entry_name(entry)}]({stem}.md) | {c.get('variant')} | {guarded} | "
                      f"{int(budget.get('timesteps', 0)):,} | {budget.get('cpu_hours', '?')} |")
+    index += ["", "What the learned messages carry, every entry side by side: [messages.md](messages.md)."]
     (out / "index.md").write_text("\n".join(index) + "\n")
-    return written + [out / "index.md"]
+    (out / "messages.md").write_text(messages_page(entries))
+    return written + [out / "index.md", out / "messages.md"]

@@ -1,5 +1,6 @@
 """The zoo: export of a run (policy only), loading with its checks, acting on the batched state."""
 import json
+import shutil
 import zipfile
 
 import numpy as np
@@ -386,3 +387,36 @@ def test_seeds_are_pooled_episode_by_episode_and_the_unusable_ones_named(tmp_pat
     one = zoo.pooled_result("A", "rl-no-msg", 1, 10, 100, 0, zoo_dir=tmp_path)
     assert one["summary"]["avg_idleness"]["ci95"] == [10.0, 11.0] and one["training_seeds"] == [0]
     assert zoo.pooled_result("A", "rl-msg", 1, 20, 100, 0, zoo_dir=tmp_path) is None
+
+
+def test_cards_gather_each_entrys_listening_and_ablation_into_a_messages_page(trained, tmp_path):
+    from patrolsb3.zoo_cards import write_cards
+    copy = tmp_path / "zoo"
+    shutil.copytree(trained["root"] / "zoo", copy)
+    entry = copy / "ROOM" / "rl-msg" / "seed0"
+    (entry / "listening.json").write_text(json.dumps({
+        "kl_nats": 0.1234, "greedy_changed": 0.05, "symbols_used": 7, "symbol_entropy_bits": 2.5,
+        "mi_own_move_bits": 0.6, "mi_others_moves_bits": 0.1, "n_agents": 3, "episodes": 2, "steps": 50, "seed": 1000}))
+    figure = {"mean": 10.0, "change": 1.0, "change_ci95": [0.5, 1.5]}          # excludes zero: starred
+    level = {"mean": 9.0, "change": 0.2, "change_ci95": [-0.4, 0.8]}           # covers zero: no star
+    (entry / "ablation.json").write_text(json.dumps({
+        "baseline": {"avg_idleness": 9.0, "max_idleness": 20.0, "collisions": 3.0},
+        "constant": {"avg_idleness": figure, "max_idleness": level, "collisions": level},
+        "shuffled": {"avg_idleness": level, "max_idleness": level, "collisions": level},
+        "n_agents": 3, "episodes": 2, "steps": 50, "seed": 1000}))
+    out = tmp_path / "cards"
+    write_cards(out, zoo_dir=copy)
+    page = (out / "messages.md").read_text()
+    listening_row = next(line for line in page.splitlines() if "rl-msg/seed0 | 0.123 |" in line)
+    assert "7 of 16" in listening_row
+    ablation_row = [line for line in page.splitlines() if "rl-msg/seed0 | +1.0 [" in line]
+    assert ablation_row and ablation_row[0].count(" *") == 1           # only the interval clear of zero
+    card_text = next(p for p in out.glob("*rl-msg-seed0.md")).read_text()
+    assert "## What its messages carry" in card_text and "| constant | 10.0 (+1.0 [+0.5, +1.5] *)" in card_text
+    assert "messages.md" in (out / "index.md").read_text()
+
+
+def test_a_card_without_message_figures_has_no_messages_section(trained):
+    from patrolsb3.zoo_cards import card
+    entry = zoo.read_entry(trained["folder"])
+    assert "What its messages carry" not in card(entry)
