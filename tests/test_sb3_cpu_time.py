@@ -72,3 +72,16 @@ def test_restart_at_gives_the_seconds_at_the_checkpoint_after_the_cut(tmp_path):
     assert read_rows(tmp_path) == [(0, 0.0), (400, 10.0), (800, 20.0)]
     assert restart_at(tmp_path, 800) == 20.0
     assert restart_at(tmp_path / "nothing", 800) == 0.0
+
+
+def test_a_stage_started_from_a_run_kept_as_a_policy_counts_that_runs_budget(tmp_path):
+    from patrolsb3.sb3.maskable_recurrent_ppo import MaskableRecurrentPPO
+    source = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
+    steps, seconds = read_rows(source)[-1]
+    model = MaskableRecurrentPPO.load(str(source / "model.zip"), device="cpu")
+    model.policy.save(str(source / "model.zip"))                    # kept as a policy only
+    run = train(map=ROOM, timesteps=400, out=tmp_path, run_id="stage2", init_from=source,
+                hyperparams=tiny_hp(curriculum=False), progress_bar=False)
+    init_from = yaml.safe_load((run / "config.yml").read_text())["init_from"]
+    assert init_from["timesteps"] == steps == 400 and init_from["cpu_hours"] == seconds / 3600
+    assert cpu_hours_of(run / "model.zip") == seconds / 3600 + read_rows(run)[-1][1] / 3600

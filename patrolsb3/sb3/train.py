@@ -305,9 +305,29 @@ def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]
     except Exception as exc:  # noqa: BLE001
         errors.append(f"as a {policy_class.__name__}: {type(exc).__name__}: {exc}")
         raise ValueError(f"--init-from: {path} cannot be loaded ({'; '.join(errors)})") from exc
-    budget = RunFolder(path.parent).read_config().get("budget") or {}
-    return policy.state_dict(), {"path": str(path), "timesteps": budget.get("timesteps"),
-                                 "cpu_hours": budget.get("cpu_hours")}
+    return policy.state_dict(), {"path": str(path), **policy_budget(RunFolder(path.parent))}
+
+
+def policy_budget(folder: RunFolder) -> dict:
+    """``timesteps`` and ``cpu_hours`` behind a policy-only ``model.zip`` (None where unknown).
+
+    A zoo entry records them in its config's ``budget``. A finished run folder whose model was
+    kept as a policy only (a stage-1 run saved for a later session) has no ``budget``; its
+    ``cpu_time.csv`` ends at the step where the run finished, so its last row, plus the stages
+    the run was itself warm-started from, gives the same two figures.
+    """
+    from .cpu_time import read_rows
+    config = folder.read_config()
+    budget = config.get("budget") or {}
+    rows = read_rows(folder.path)
+    if budget or not rows:
+        return {"timesteps": budget.get("timesteps"), "cpu_hours": budget.get("cpu_hours")}
+    steps, seconds = rows[-1]                                  # the run's last record: its end
+    earlier = config.get("init_from") or {}
+    if earlier and (earlier.get("timesteps") is None or earlier.get("cpu_hours") is None):
+        return {"timesteps": None, "cpu_hours": None}          # an unmeasured stage before it
+    return {"timesteps": steps + int(earlier.get("timesteps") or 0),
+            "cpu_hours": seconds / 3600 + float(earlier.get("cpu_hours") or 0.0)}
 
 
 def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="runs/", algo: str | None = None,
