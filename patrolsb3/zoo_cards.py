@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from . import ablation
 from .report import ZOO_TABLE_METRICS, mean_std
 
 VARIANT_TEXT = {"rl-msg": "learned 16-symbol messages (RIAL)", "rl-no-msg": "positions only, no messages",
@@ -42,8 +43,9 @@ def load_line(entry: dict) -> str:
             f"--strategy {strategy_name(c.get('variant'), bool(entry.get('guard')))}")
 
 
-ABLATION_METRICS = (("avg_idleness", "AVG^h"), ("max_idleness", "MAX^h"), ("collisions", "collisions"))
-ABLATIONS = ("constant", "shuffled")
+METRIC_LABEL = {"avg_idleness": "AVG^h", "max_idleness": "MAX^h", "collisions": "collisions"}
+ABLATION_METRICS = tuple((m, METRIC_LABEL[m]) for m in ablation.METRICS)   # what zoo ablation measures
+ABLATIONS = ablation.MODES
 
 
 def message_figures(entry: dict) -> tuple[dict | None, dict | None]:
@@ -78,23 +80,23 @@ LISTENING_HEADER = ("| listening KL (nats) | greedy move changed | symbols used 
 
 def messages_section(entry: dict) -> list[str]:
     """The card's "What its messages carry" section; empty when the entry has no figures."""
-    listening, ablation = message_figures(entry)
+    listening, figures = message_figures(entry)
     lines = []
-    if listening or ablation:
+    if listening or figures:
         lines += ["## What its messages carry", ""]
     if listening:
         lines += [f"`patrolsb3 zoo listening` ({listening['n_agents']} agents, {listening['episodes']} "
                   f"episodes x {listening['steps']} steps, seed {listening['seed']}):", "",
                   LISTENING_HEADER, "|---" * 6 + "|", "| " + " | ".join(listening_cells(listening)) + " |", ""]
-    if ablation:
-        lines += [f"`patrolsb3 zoo ablation` ({ablation['n_agents']} agents, {ablation['episodes']} episodes "
-                  f"x {ablation['steps']} steps, seed {ablation['seed']}; change = ablated - as trained, "
+    if figures:
+        lines += [f"`patrolsb3 zoo ablation` ({figures['n_agents']} agents, {figures['episodes']} episodes "
+                  f"x {figures['steps']} steps, seed {figures['seed']}; change = ablated - as trained, "
                   f"95 % interval of the paired difference, * where it excludes zero):", "",
                   "| received | " + " | ".join(h for _, h in ABLATION_METRICS) + " |", "|---" * 4 + "|",
-                  "| as sent | " + " | ".join(f"{ablation['baseline'][k]:.1f}" for k, _ in ABLATION_METRICS) + " |"]
+                  "| as sent | " + " | ".join(f"{figures['baseline'][k]:.1f}" for k, _ in ABLATION_METRICS) + " |"]
         for kind in ABLATIONS:
             lines.append(f"| {kind} | " + " | ".join(
-                f"{ablation[kind][k]['mean']:.1f} ({change_text(ablation[kind][k])})" for k, _ in ABLATION_METRICS) + " |")
+                f"{figures[kind][k]['mean']:.1f} ({change_text(figures[kind][k])})" for k, _ in ABLATION_METRICS) + " |")
         lines.append("")
     return lines
 
