@@ -127,9 +127,12 @@ def sweep_on_ray(trials, cpus_per_trial: int = 1, storage: Path | None = None,
     for result in tuner.fit():
         trial = by_index[result.config["trial"]]
         metrics = result.metrics or {}
-        outcome[trial.name] = {"status": "error" if result.error else "finished",
-                               "seconds": float(metrics.get("seconds", 0.0)),
-                               "error": _cause(result.error) if result.error else ""}
+        error = _cause(result.error) if result.error else ""
+        reached = int(metrics.get("timesteps", 0))
+        if not error and reached < trial.timesteps:
+            error = f"the trial ended at {reached:,} of its {trial.timesteps:,} agent-steps"
+        outcome[trial.name] = {"status": "error" if error else "finished",
+                               "seconds": float(metrics.get("seconds", 0.0)), "error": error}
     return outcome
 
 

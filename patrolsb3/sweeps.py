@@ -2,7 +2,8 @@
 
 A sweep file (``patrolsb3 sweep SWEEP.yml``)::
 
-    out: runs/sweep-a            # root of the run folders (--out overrides)
+    out: runs/sweep-a            # root of the run folders (--out overrides); a relative path is
+                                 # relative to the working directory, as train's --out
     timesteps: 400000            # agent-steps of every trial
     recipe: zoo-stage1           # optional: named overrides (patrolsb3/sb3/recipes.py)
     set:                         # optional: --set keys applied to every trial
@@ -19,14 +20,16 @@ Each trial trains with :func:`patrolsb3.sb3.train.train` into
 OUT --run-id ID``), so its folder holds what a train run holds and every tool that reads run
 folders reads it. The folders are the sweep's state: a trial whose ``model.zip`` has its
 agent-steps is finished and skipped, one with a checkpoint resumes from it (``--resume``), any
-other starts afresh. Running the same sweep again therefore finishes what is left and starts
+new one starts afresh; an existing folder with neither is reported and left alone (the sweep
+deletes nothing). Running the same sweep again therefore finishes what is left and starts
 nothing when all is done. Ray (``patrolsb3.distributed``) only spreads the trials over CPUs
-and machines.
+and machines; the run folders' root is made absolute before any trial starts (Ray runs each
+trial in a working directory of its own), and a trial that ends short of its agent-steps is
+an error.
 """
 from __future__ import annotations
 
 import itertools
-import shutil
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -119,12 +122,13 @@ def _map_folder(map_name: str) -> str:
         return Path(map_name).name.replace(" ", "_")
 
 
-def read_sweep(path, out=None) -> list[Trial]:
+def read_sweep(path, out=None, precision: str | None = None) -> list[Trial]:
     """The trials of a sweep file, in grid order.
 
     Args:
         path: the YAML sweep file (module docstring).
         out: the root of the run folders (default: the file's ``out``).
+        precision: the training precision of every trial (``--precision``), over the file's.
 
     Raises:
         SweepError: not YAML, an unknown key, a grid value that is not a non-empty list, no
@@ -154,6 +158,7 @@ def read_sweep(path, out=None) -> list[Trial]:
     root = out if out is not None else spec.get("out")
     if not root:
         raise SweepError(f"{path}: no 'out' folder (give it in the file or with --out)")
+    root = Path(root).expanduser().absolute()          # the working directory's, before Ray moves it
     fixed = spec.get("set") or {}
     grid_set = grid.get("set") or {}
     if not isinstance(fixed, dict) or not isinstance(grid_set, dict):
@@ -168,6 +173,8 @@ def read_sweep(path, out=None) -> list[Trial]:
             raise SweepError(f"{path}: grid seeds must be whole numbers, got {seed!r}")
     base = recipe(spec["recipe"]) if spec.get("recipe") else {}
     base = merge(base, fixed)
+    if precision is not None:
+        base = merge(base, {"precision": precision})
     trials = []
     for combo in itertools.product(*axes.values()):
         values = dict(zip(axes, combo))
@@ -196,12 +203,19 @@ def check_trial(trial: Trial) -> str:
 
 
 def trial_state(trial: Trial) -> str:
-    """finished (model.zip at its agent-steps), resumable (a valid checkpoint) or new."""
+    """finished (model.zip at its agent-steps), resumable (a valid checkpoint), new (no folder,
+    or an empty one) or blocked (a folder with files but nothing to resume: never replaced)."""
     from .runs import RunFolder, model_steps
     run = RunFolder(trial.run_dir)
     if run.model_file.is_file() and (model_steps(run.model_file) or 0) >= trial.timesteps:
         return "finished"
-    return "resumable" if run.newest_checkpoint() is not None else "new"
+    if run.newest_checkpoint() is not None:
+        return "resumable"
+    return "blocked" if run.path.is_dir() and any(run.path.iterdir()) else "new"
+
+
+BLOCKED = ("its run folder {} exists with files but no checkpoint to resume; the sweep does not replace it "
+           "(move it away or delete it, then run the sweep again)")
 
 
 def run_trial(trial: Trial, torch_threads: int = 1) -> dict:
@@ -216,8 +230,10 @@ def run_trial(trial: Trial, torch_threads: int = 1) -> dict:
     from .sb3.train import train
     started = time.time()
     state = trial_state(trial)
+    if state == "blocked":
+        raise ValueError(BLOCKED.format(trial.run_dir))
     if state == "new" and trial.run_dir.exists():
-        shutil.rmtree(trial.run_dir)
+        trial.run_dir.rmdir()                           # empty: train makes it again
     if state != "finished":
         hyperparams = merge({"torch_threads": int(torch_threads)}, trial.overrides)
         train(map=trial.map, variant=trial.variant, timesteps=trial.timesteps, seed=trial.seed,
@@ -228,7 +244,7 @@ def run_trial(trial: Trial, torch_threads: int = 1) -> dict:
             "seconds": round(time.time() - started, 1)}
 
 
-def run_sweep(path, out=None, address: str | None = None, cpus: int | None = None, cpus_per_trial: int = 1,
+def run_sweep(path, out=None, precision: str | None = None, address: str | None = None, cpus: int | None = None, cpus_per_trial: int = 1,
               dry_run: bool = False, say=print) -> list[TrialOutcome]:
     """A sweep from its file to its outcomes (what ``patrolsb3 sweep`` runs).
 
@@ -238,6 +254,7 @@ def run_sweep(path, out=None, address: str | None = None, cpus: int | None = Non
     Args:
         path: the sweep file (module docstring).
         out: root of the run folders (default: the file's ``out``).
+        precision: the training precision of every trial (default: the file's or the YAML's).
         address: a Ray cluster to join; None starts Ray on this machine.
         cpus: CPUs a local Ray may use (default: all).
         cpus_per_trial: CPUs (and torch threads) per trial.
@@ -257,7 +274,7 @@ def run_sweep(path, out=None, address: str | None = None, cpus: int | None = Non
         raise ValueError(f"cpus_per_trial must be a whole number >= 1, got {cpus_per_trial!r}")
     if cpus is not None and (isinstance(cpus, bool) or not isinstance(cpus, int) or cpus < 1 or address):
         raise ValueError(f"cpus must be a whole number >= 1, for a local Ray only (not with an address), got {cpus!r}")
-    trials = read_sweep(path, out=out)
+    trials = read_sweep(path, out=out, precision=precision)
     check_output_dir(trials[0].run_dir.parents[2], "--out")
     outcomes = {t.name: TrialOutcome(t, "pending") for t in trials}
     to_run, resuming = [], 0
@@ -268,7 +285,10 @@ def run_sweep(path, out=None, address: str | None = None, cpus: int | None = Non
             say(f"trial {t.name}: refused before it started: {problem}")
             continue
         state = trial_state(t)          # reads (and checks) its checkpoints once
-        if state == "finished":
+        if state == "blocked":
+            outcomes[t.name] = TrialOutcome(t, "error", error=BLOCKED.format(t.run_dir))
+            say(f"trial {t.name}: refused before it started: {BLOCKED.format(t.run_dir)}")
+        elif state == "finished":
             outcomes[t.name] = TrialOutcome(t, "skipped")
         else:
             to_run.append(t)

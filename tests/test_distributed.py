@@ -106,3 +106,30 @@ def test_compare_on_ray_gives_the_serial_figures(tmp_path, capsys):
     assert "ray: 1 cells on 2 CPUs" in capsys.readouterr().out
     assert figures(tmp_path / "serial") == figures(tmp_path / "ray")
     shutil.rmtree(tmp_path / "ray")
+
+
+def test_a_relative_out_is_the_working_directorys_even_on_ray(tmp_path, monkeypatch, capsys):
+    """Ray runs each trial in a working directory of its own: the sweep resolves ``out`` first,
+    so the run folders land where the user ran the command, at their agent-steps."""
+    (tmp_path / "room.txt").write_text(ROOM)
+    path = tmp_path / "sweep.yml"
+    path.write_text(SETTINGS.format(out="runs/rel", room=tmp_path / "room.txt", sizes="[8]").replace(
+        "seed: [0, 1]", "seed: [0]"))
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(["sweep", str(path)]) == 0
+    run = tmp_path / "runs" / "rel" / "room" / "rl-msg" / "seed0_policy_kwargs.lstm_hidden_size=8"
+    assert model_steps(RunFolder(run).model_file) == 1600
+    assert "| room/rl-msg/seed0_policy_kwargs.lstm_hidden_size=8 | finished | 1,600 |" in capsys.readouterr().out
+
+
+def test_a_folder_the_sweep_cannot_resume_is_reported_and_left_alone(tmp_path, capsys):
+    path = sweep_file(tmp_path)
+    run = tmp_path / "runs" / "room" / "rl-msg" / "seed0_policy_kwargs.lstm_hidden_size=8"
+    run.mkdir(parents=True)
+    (run / "notes.txt").write_text("mine")
+    assert cli.main(["sweep", str(path)]) == 1
+    out = capsys.readouterr().out
+    assert "exists with files but no checkpoint to resume; the sweep does not replace it" in out
+    assert (run / "notes.txt").read_text() == "mine" and not (run / "model.zip").exists()
+    other = tmp_path / "runs" / "room" / "rl-msg" / "seed1_policy_kwargs.lstm_hidden_size=8"
+    assert model_steps(RunFolder(other).model_file) == 1600        # the other trial ran

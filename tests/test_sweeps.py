@@ -111,3 +111,17 @@ def test_without_ray_sweep_and_compare_ray_say_how_to_install_it(tmp_path, capsy
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and 'pip install -e ".[ray]"' in err
     assert not (tmp_path / "runs").exists() and not (tmp_path / "c" / "results.json").exists()
+
+
+def test_a_relative_out_is_made_absolute_from_the_working_directory(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    trial, = read_sweep(write(tmp_path, "out: runs/rel\ntimesteps: 400\ngrid: {map: [A]}"))
+    assert trial.run_dir == tmp_path / "runs" / "rel" / "A" / "rl-msg" / "seed0"
+
+
+def test_a_folder_with_files_and_no_checkpoint_is_blocked_not_new(tmp_path):
+    trial, = read_sweep(write(tmp_path, f"out: {tmp_path}\ntimesteps: 400\ngrid: {{map: [A]}}"))
+    trial.run_dir.mkdir(parents=True)
+    assert trial_state(trial) == "new"                               # empty: the sweep may start it
+    (trial.run_dir / "curve.csv").write_text("timesteps\n")
+    assert trial_state(trial) == "blocked"

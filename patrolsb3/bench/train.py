@@ -13,7 +13,8 @@ Three counts of the same wall time:
 The wall time of a short ``learn()`` is split into ``env_s`` (inside ``env.step``),
 ``forward_s`` (policy forward passes during collection) and ``update_s`` (``train()``: the PPO
 epochs); the rest (masks, buffer, callbacks) is ``other_s``. Figures are printed for
-``torch_threads`` 1 (the default) and 2.
+``torch_threads`` 1 (the default) and 2, with the training precision (``--precision``), the
+CPU's name and whether it computes bf16 natively.
 """
 from __future__ import annotations
 
@@ -58,6 +59,7 @@ def measure(n_rollouts: int = 2, n_steps: int | None = None, seed: int = 0, over
 
     from ..sb3.algorithms import get_algorithm, torch_device
     from ..sb3.hyperparams import merge
+    from ..sb3.precision import resolve_precision
     from ..sb3.train import algorithm_kwargs, resolve_hyperparams
     from ..sb3.vec_env import DEFAULT_AGENTS, make_vec_env
 
@@ -71,6 +73,7 @@ def measure(n_rollouts: int = 2, n_steps: int | None = None, seed: int = 0, over
     rows = vec_env.num_envs
     model = cls(policy_cls, vec_env, seed=seed, device=device,
                 **algorithm_kwargs(hp, spec, vec_env.layout, vec_env.phases_per_step, rows))
+    model.policy.precision = resolve_precision(hp.get("precision", "fp32"), model.device.type)
     timers = {"env_s": 0.0, "forward_s": 0.0, "update_s": 0.0}
     counts = {"useful": 0}
     step = vec_env.step
@@ -99,6 +102,7 @@ def measure(n_rollouts: int = 2, n_steps: int | None = None, seed: int = 0, over
     out["n_steps"] = int(model.n_steps)
     out["torch_threads"] = int(hp.get("torch_threads", 1))
     out["device"] = str(model.device)
+    out["precision"] = model.policy.precision
     return out
 
 
@@ -117,6 +121,7 @@ def run(repeats: int = 5, quick: bool = False, device: str = "cpu", threads=(1, 
     Returns:
         The figures of the first thread count, and ``threads_<k>`` entries with the others'.
     """
+    from ..sb3.precision import cpu_info
     out = {}
     for k in threads:
         hp = {**(overrides or {}), "torch_threads": int(k)}
@@ -125,7 +130,8 @@ def run(repeats: int = 5, quick: bool = False, device: str = "cpu", threads=(1, 
         best = _median_run(runs)
         if not out:
             out = best
-            out.update({"algo": "MaskableRecurrentPPO", "map": "A", "rows": 40, "repeats": repeats})
+            out.update({"algo": "MaskableRecurrentPPO", "map": "A", "rows": 40, "repeats": repeats,
+                        "cpu": cpu_info()["name"], "cpu_native_bf16": cpu_info()["native_bf16"]})
         else:
             out[f"threads_{k}"] = {key: best[key] for key in ("agent_steps_per_s", "deployed_agent_sim_steps_per_s",
                                                               "useful_decisions_per_s", "update_s", "total_s")}

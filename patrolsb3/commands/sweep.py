@@ -13,6 +13,8 @@ def add_arguments(parser):
                         help="CPUs a local Ray may use (default: all); not with --address")
     parser.add_argument("--cpus-per-trial", type=int, default=1,
                         help="CPUs reserved for each trial, also its torch threads (default 1)")
+    parser.add_argument("--precision", default=None, choices=["auto", "fp32", "bf16"],
+                        help="training precision of every trial (default: the sweep's or the hyperparameters')")
     parser.add_argument("--dry-run", action="store_true", help="list the trials and their state, start nothing")
 
 
@@ -20,7 +22,7 @@ def run(args):
     from functools import partial
 
     from ..sweeps import run_sweep, summary_table
-    outcomes = run_sweep(args.sweep_file, out=args.out, address=args.address, cpus=args.cpus,
+    outcomes = run_sweep(args.sweep_file, out=args.out, precision=args.precision, address=args.address, cpus=args.cpus,
                          cpus_per_trial=args.cpus_per_trial, dry_run=args.dry_run, say=partial(print, flush=True))
     print(summary_table(outcomes))
     return 1 if any(o.status == "error" for o in outcomes) else 0

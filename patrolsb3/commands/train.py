@@ -15,9 +15,10 @@ def add_arguments(parser):
     parser.add_argument("--init-from", default=None, metavar="MODEL",
                         help="start a new run from the policy weights of a checkpoint, run folder or zoo entry")
     parser.add_argument("--hyperparams", default=None, help="YAML keyed by map with a default: entry")
-    parser.add_argument("--recipe", default="paper",
-                        help="named overrides on top of the YAML: paper (default: its values), zoo-stage1, "
-                             "zoo-stage2 (patrolsb3/sb3/recipes.py); --set applies on top")
+    parser.add_argument("--recipe", default="default",
+                        help="named overrides on top of the YAML: default (its values), paper (the paper's "
+                             "training as written: one whole episode per rollout, 50 minibatches), zoo-stage1, "
+                             "zoo-stage2 (patrolsb3/sb3/recipes.py, docs/training.md); --set applies on top")
     parser.add_argument("--set", nargs="+", action="extend", default=[], metavar="KEY=VALUE",
                         help="override hyperparameters, e.g. n_steps=128 policy_kwargs.lstm_hidden_size=64 "
                              "env.episode_steps=1000")
@@ -25,6 +26,9 @@ def add_arguments(parser):
     parser.add_argument("--checkpoint-freq", type=int, default=None, help="agent-steps between checkpoints")
     parser.add_argument("--device", default="auto", choices=["auto", "cpu", "cuda"],
                         help="where the networks train (default auto: cuda when torch sees one, else cpu)")
+    parser.add_argument("--precision", default=None, choices=["auto", "fp32", "bf16"],
+                        help="what the networks compute in while training (default: the hyperparameters' "
+                             "precision): bf16 mixed precision where the CPU has it (docs/training.md)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--verbose", type=int, default=0)
 
@@ -36,6 +40,8 @@ def run(args):
     from ..sb3.recipes import recipe
     from ..sb3.train import train
     overrides = merge(recipe(args.recipe), parse_set(args.set))
+    if args.precision is not None:
+        overrides["precision"] = args.precision
     run_dir = train(map=args.map, variant=args.variant, timesteps=args.timesteps, out=args.out, algo=args.algo,
                     seed=args.seed, resume=args.resume, init_from=args.init_from, hyperparams=overrides,
                     hyperparams_file=args.hyperparams, eval_freq=args.eval_freq,

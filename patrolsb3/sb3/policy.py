@@ -16,6 +16,7 @@ features, not the 512 of the convolutions.
 """
 from __future__ import annotations
 
+import contextlib
 from typing import Any
 
 import numpy as np
@@ -28,6 +29,8 @@ from sb3_contrib.common.recurrent.type_aliases import RNNStates
 from stable_baselines3.common.policies import BasePolicy
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
+
+from .precision import autocast
 
 ROLES = ("actor", "critic")
 
@@ -97,7 +100,28 @@ def _extractor_kwargs(grid_shape, vector_size, critic_size, conv_channels, dense
 
 class _RoleExtractorMixin:
     """SB3's ActorCriticPolicy calls ``make_features_extractor`` twice when the extractor is
-    not shared: first for the actor, then for the critic. Give each its role."""
+    not shared: first for the actor, then for the critic. Give each its role.
+
+    Also the training precision (:mod:`patrolsb3.sb3.precision`): ``precision`` ("fp32" or
+    "bf16", set by ``train`` for the run; not saved with the policy, so a loaded policy is
+    fp32) is what the trunks compute in during the rollout and the update; ``predict`` is
+    always fp32.
+    """
+
+    precision = "fp32"
+
+    def trunk_context(self):
+        """The context the trunks (convolutions, Dense stack, LSTM) run in."""
+        return autocast(self.precision, self.device.type)
+
+    @contextlib.contextmanager
+    def full_precision(self):
+        """Within it, the trunks compute in fp32 whatever the run's precision (prediction)."""
+        saved, self.precision = self.precision, "fp32"
+        try:
+            yield
+        finally:
+            self.precision = saved
 
     def make_features_extractor(self) -> BaseFeaturesExtractor:
         role = "critic" if "pi_features_extractor" in self._modules else "actor"
@@ -226,17 +250,23 @@ class PatrolRecurrentPolicy(_RoleExtractorMixin, RecurrentActorCriticPolicy):
         return th.flatten(output.transpose(0, 1), start_dim=0, end_dim=1), states      # (n_seq*T, hidden)
 
     def _latents(self, obs: th.Tensor, lstm_states: RNNStates, episode_starts: th.Tensor, by_hand: bool = False):
-        """Actor and critic latents and the new states (the recurrent half of forward)."""
-        pi_features, vf_features = self.extract_features(obs)
-        latent_pi, states_pi = self._process_sequence(pi_features, lstm_states.pi, episode_starts, self.lstm_actor,
-                                                      by_hand)
-        if self.lstm_critic is not None:
-            latent_vf, states_vf = self._process_sequence(vf_features, lstm_states.vf, episode_starts,
-                                                          self.lstm_critic, by_hand)
-        else:
-            latent_vf, states_vf = self.critic(vf_features), states_pi
-        return (self.mlp_extractor.forward_actor(latent_pi), self.mlp_extractor.forward_critic(latent_vf),
-                RNNStates(states_pi, states_vf))
+        """Actor and critic latents (B, hidden) fp32 and the new states (the recurrent half of
+        forward); the trunks run in the policy's precision, the latents and states come out fp32."""
+        with self.trunk_context():
+            pi_features, vf_features = self.extract_features(obs)
+            latent_pi, states_pi = self._process_sequence(pi_features, lstm_states.pi, episode_starts,
+                                                          self.lstm_actor, by_hand)
+            if self.lstm_critic is not None:
+                latent_vf, states_vf = self._process_sequence(vf_features, lstm_states.vf, episode_starts,
+                                                              self.lstm_critic, by_hand)
+            else:
+                latent_vf, states_vf = self.critic(vf_features), states_pi
+            latent_pi = self.mlp_extractor.forward_actor(latent_pi)
+            latent_vf = self.mlp_extractor.forward_critic(latent_vf)
+        if self.precision == "fp32":
+            return latent_pi, latent_vf, RNNStates(states_pi, states_vf)
+        states_pi, states_vf = (tuple(t.float() for t in states_pi), tuple(t.float() for t in states_vf))
+        return latent_pi.float(), latent_vf.float(), RNNStates(states_pi, states_vf)
 
     def _masked_distribution(self, latent_pi: th.Tensor, action_masks):
         distribution = self._get_action_dist_from_latent(latent_pi)
@@ -299,6 +329,10 @@ class PatrolRecurrentPolicy(_RoleExtractorMixin, RecurrentActorCriticPolicy):
             action_masks: (n, 21) legal actions; None samples without masks.
         """
         self.set_training_mode(False)
+        with self.full_precision():
+            return self._predict_rows(observation, state, episode_start, deterministic, action_masks)
+
+    def _predict_rows(self, observation, state, episode_start, deterministic, action_masks):
         obs_tensor, vectorized = self.obs_to_tensor(observation)
         n_envs = obs_tensor.shape[0]
         if state is None:
@@ -340,6 +374,19 @@ class PatrolMaskablePolicy(_RoleExtractorMixin, MaskableActorCriticPolicy):
         kwargs["features_extractor_kwargs"] = _extractor_kwargs(grid_shape, vector_size, critic_size,
                                                                 conv_channels, dense_sizes)
         super().__init__(observation_space, action_space, lr_schedule, **kwargs)
+
+    def extract_features(self, obs, features_extractor=None):
+        """SB3's, with the trunks in the policy's precision; the features come out fp32."""
+        with self.trunk_context():
+            features = super().extract_features(obs, features_extractor)
+        if self.precision == "fp32":
+            return features
+        return tuple(f.float() for f in features) if isinstance(features, tuple) else features.float()
+
+    def predict(self, *args, **kwargs):
+        """SB3's ``predict``, always in fp32."""
+        with self.full_precision():
+            return super().predict(*args, **kwargs)
 
     def _get_constructor_parameters(self) -> dict[str, Any]:
         data = super()._get_constructor_parameters()

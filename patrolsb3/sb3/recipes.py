@@ -1,6 +1,16 @@
 """Named training recipes: hyperparameter overrides applied on top of the YAML's (``patrolsb3
 train --recipe NAME``; ``--set`` applies on top of the recipe).
 
+* ``default``: the YAML's values (the paper's, with a 256-step rollout of 2,048-row
+  minibatches so that short runs update often).
+* ``paper``: the paper's training as written (docs/training.md, "The paper's recipe"): every
+  value of its tables, and its rollout: each update collects one whole training episode of the
+  8 parallel episodes (``n_steps: episode``, 5,000 simulator steps) and splits it into 50
+  minibatches. Its budget, 1,500 training episodes, is the run's ``timesteps``: 7.5 M episode
+  steps = 937,500 steps of the 8 episodes = 937,500 x 40 rows x phases agent-steps (75 M for
+  rl-msg and rl-intention, 37.5 M for rl-no-msg); the curriculum and the learning-rate drop
+  fall at the paper's episodes when the run has that budget.
+
 The paper-setting zoo trains in two stages (``zoo/train_paper_setting.sh`` runs them):
 
 * ``zoo-stage1``: the patrol with the battery out of the way: 300-step episodes, full batteries.
@@ -22,15 +32,34 @@ from typing import Any
 SHARED = {"normalize_reward": True, "gamma": 0.99, "batch_size": 2048,
           "env": {"local_idleness": True, "c_d": 200.0, "message_encoding": "planes"}}
 
+PAPER = {"n_steps": "episode", "n_minibatches": 50}
+"""The paper's rollout over the YAML's values (which are the paper's for everything else)."""
+
+PAPER_EPISODES = 1500
+"""Training episodes of the paper's budget (its section "Model Training")."""
+
 RECIPES = {
-    "paper": {},
+    "default": {},
+    "paper": PAPER,
     "zoo-stage1": {**SHARED, "learning_rate": "drop_6e-4_3e-4",
                    "env": {**SHARED["env"], "episode_steps": 300, "init_battery": [1.0, 1.0]}},
     "zoo-stage2": {**SHARED, "learning_rate": 3e-4, "curriculum": False,
                    "env": {**SHARED["env"], "episode_steps": 1500, "init_battery": [0.15, 1.0], "c_home": 50.0},
                    "mix": {"episodes": [0, 2, 4, 6], "env": {"episode_steps": 400, "init_battery": [0.05, 0.4]}}},
 }
-"""Recipe name -> hyperparameter overrides ("paper": the YAML's values, the paper's)."""
+"""Recipe name -> hyperparameter overrides ("default": the YAML's values)."""
+
+
+def paper_budget(phases_per_step: int, max_agents: int = 5, episode_steps: int = 5000,
+                 episodes: int = PAPER_EPISODES) -> int:
+    """Agent-steps (``--timesteps``) of the paper's budget: ``episodes`` training episodes of
+    ``episode_steps``, counted one per parallel episode (our reading; docs/training.md), each
+    step of which is ``max_agents`` rows (slots) x ``phases_per_step`` env steps.
+
+    >>> paper_budget(2)      # rl-msg, rl-intention: 937,500 steps of the 8 episodes
+    75000000
+    """
+    return episodes * episode_steps * max_agents * phases_per_step
 
 
 def recipe(name: str) -> dict:

@@ -25,6 +25,7 @@ from .algorithms import DEFAULT_ALGORITHM, get_algorithm, torch_device
 from .cpu_time import cpu_hours_of
 from .curriculum import CURRICULUM
 from .hyperparams import load_hyperparams, merge, per_phase, schedule
+from .precision import PRECISIONS, resolve_precision
 
 COMMUNICATION_KEYS = ("ent_coef_message", "signal_coef", "listen_coef", "message_team_share")
 """Optional coefficients of MaskableRecurrentPPO for learned messages (None: off)."""
@@ -32,7 +33,7 @@ ALGO_KEYS = ("learning_rate", "n_steps", "n_epochs", "gamma", "gae_lambda", "cli
              "vf_coef", "max_grad_norm", "n_minibatches", "batch_size", "policy_kwargs", "target_kl",
              *COMMUNICATION_KEYS)
 RUN_KEYS = ("algo", "timesteps", "n_envs", "curriculum", "env", "checkpoint_freq", "eval_freq",
-            "eval_episode_steps", "eval_episodes", "torch_threads", "normalize_reward", "mix")
+            "eval_episode_steps", "eval_episodes", "torch_threads", "normalize_reward", "mix", "precision")
 
 
 def curriculum_teams(n_envs: int, max_agents: int, curriculum=CURRICULUM) -> list[list[int]]:
@@ -108,20 +109,36 @@ def resolve_hyperparams(map_name: str, hyperparams_file=None, overrides: dict | 
     return hp
 
 
-def algorithm_kwargs(hp: dict, spec, layout, phases_per_step: int, rows: int) -> dict:
+ROLLOUT_EPISODE = "episode"
+"""``n_steps: episode``: a rollout of one whole training episode per row (the paper's: it
+collects its 8 parallel episodes of 5,000 steps, then splits them into 50 minibatches)."""
+
+
+def rollout_env_steps(n_steps, episode_steps: int, phases_per_step: int) -> int:
+    """Env steps per row of a rollout: ``n_steps``, or with ``n_steps: episode`` one training
+    episode (``episode_steps`` simulator steps x the variant's phases per step)."""
+    if n_steps == ROLLOUT_EPISODE:
+        return int(episode_steps) * int(phases_per_step)
+    return int(n_steps)
+
+
+def algorithm_kwargs(hp: dict, spec, layout, phases_per_step: int, rows: int, episode_steps: int | None = None) -> dict:
     """Constructor arguments of the SB3 algorithm from resolved hyperparameters.
 
     Minibatches: ``batch_size`` rows, unless ``n_minibatches`` is given: then
     MaskableRecurrentPPO splits each rollout's deployed rows into that many minibatches, and
     the sb3-contrib algorithms (which train on every row) use ``n_steps * rows / n_minibatches``.
     Gamma and GAE lambda are converted per env step; policy_kwargs the algorithm's policy does
-    not take are dropped.
+    not take are dropped. ``episode_steps`` (the training episode's simulator steps; default
+    the env's) gives the rollout of ``n_steps: episode``.
 
     Raises:
         ValueError: neither ``batch_size`` nor ``n_minibatches``, or one below 1.
     """
     from .policy import policy_kwargs_for
-    n_steps = int(hp["n_steps"])
+    if episode_steps is None:
+        episode_steps = (hp.get("env") or {}).get("episode_steps", EnvConfig.episode_steps)
+    n_steps = rollout_env_steps(hp["n_steps"], episode_steps, phases_per_step)
     n_minibatches = hp.get("n_minibatches")
     batch_size = hp.get("batch_size")
     for key, value in (("batch_size", batch_size), ("n_minibatches", n_minibatches)):
@@ -166,8 +183,11 @@ def check_run_settings(hp: dict, total) -> None:
         value = values[key]
         if value is None and key in ("batch_size", "n_minibatches"):
             continue
+        if key == "n_steps" and value == ROLLOUT_EPISODE:
+            continue
         if isinstance(value, bool) or not isinstance(value, int) or value < low:
-            raise ValueError(f"{key} must be a whole number >= {low}, got {value!r}")
+            raise ValueError(f"{key} must be a whole number >= {low}"
+                             + (f" or '{ROLLOUT_EPISODE}'" if key == "n_steps" else "") + f", got {value!r}")
     for key in ("learning_rate", "clip_range", "gamma", "gae_lambda", "ent_coef", "vf_coef", "max_grad_norm",
                 *COMMUNICATION_KEYS):
         if key == "learning_rate":
@@ -180,6 +200,8 @@ def check_run_settings(hp: dict, total) -> None:
         if hp.get(key) is not None and get_algorithm(hp.get("algo", DEFAULT_ALGORITHM)).name \
                 != "MaskableRecurrentPPO":
             raise ValueError(f"{key} is a setting of MaskableRecurrentPPO, not of {hp.get('algo')}")
+    if hp.get("precision", "fp32") not in PRECISIONS:
+        raise ValueError(f"precision must be one of {', '.join(PRECISIONS)}, got {hp.get('precision')!r}")
     if hp.get("message_team_share") is not None and not 0.0 <= float(hp["message_team_share"]) <= 1.0:
         raise ValueError(f"message_team_share must be between 0 and 1 (a share of the team's reward), got "
                          f"{hp['message_team_share']}")
@@ -233,6 +255,21 @@ def _check_resumable(run: RunFolder, config: dict) -> Path:
         if saved.get("env") != config["env"]:
             raise ValueError(f"--resume: the env config of {run_dir} differs from this run's")
     return checkpoint
+
+
+def run_precision(hp: dict, device_type: str, resumed: RunFolder | None = None) -> str:
+    """The precision (``fp32`` or ``bf16``) a run trains with: its ``precision`` hyperparameter
+    resolved on this device (:func:`patrolsb3.sb3.precision.resolve_precision`); a resumed run
+    keeps the one its config.yml records (``fp32`` when it records none: runs from before the
+    setting existed), and says so on stderr when the hyperparameters asked for another."""
+    wanted = resolve_precision(hp.get("precision", "fp32"), device_type)
+    if resumed is None or not resumed.config_file.is_file():
+        return wanted
+    kept = (resumed.read_config().get("hyperparams") or {}).get("precision", "fp32")
+    if kept != wanted:
+        print(f"--resume: {resumed.path} keeps the precision it was trained with ({kept}), not {wanted}",
+              file=sys.stderr)
+    return kept
 
 
 def mixed_episodes(hp: dict, n_episodes: int) -> dict:
@@ -400,6 +437,8 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
         checkpoint = None
     model, vec_env = _build_model(spec_map, variant, spec, hp, seed, start_teams, checkpoint, warm_weights,
                                   config, run, device, verbose)
+    model.policy.precision = run_precision(hp, model.device.type, run if checkpoint is not None else None)
+    config["hyperparams"] = {**hp, "precision": model.policy.precision}
     # every setting has been accepted (the model is built): now the run folder is made
     run.create()
     if checkpoint is not None:
@@ -490,7 +529,8 @@ def _build_model(spec_map, variant: str, spec, hp: dict, seed: int, start_teams,
         if verbose:
             print(f"resuming {run.path} from {checkpoint.name} at {model.num_timesteps} timesteps")
         return model, vec_env
-    kwargs = algorithm_kwargs(hp, spec, vec_env.layout, vec_env.phases_per_step, rows)
+    kwargs = algorithm_kwargs(hp, spec, vec_env.layout, vec_env.phases_per_step, rows,
+                              episode_steps=config["env"]["episode_steps"])
     model = cls(policy_cls, vec_env, tensorboard_log=str(run.tensorboard_dir), seed=seed, verbose=verbose,
                 device=device, **kwargs)
     if warm_weights is not None:
