@@ -24,19 +24,29 @@ def _writable_ancestor(path: Path, argument: str) -> None:
             return
 
 
-def check_output_file(path, argument: str) -> Path:
-    """A file the command will write: not a folder, writable, under a folder that is or can be made.
+def check_output_file(path, argument: str, inputs=()) -> Path:
+    """A file the command will write: not a folder, writable, under a folder that is or can be
+    made, and none of the command's ``inputs`` (files, or folders whose files it reads).
 
     Raises:
         ValueError: names ``argument`` (e.g. "--json") and the cause.
     """
     path = Path(path)
+    for given in inputs:
+        given = Path(given)
+        if path.resolve() == given.resolve() or (given.is_dir() and path.resolve().parent == given.resolve()
+                                                 and path.name in INPUT_NAMES):
+            raise ValueError(f"{argument} {path}: is an input of this command; give another file name")
     if path.is_dir():
         raise ValueError(f"{argument} {path}: is a folder; give a file name")
     if path.exists() and not os.access(path, os.W_OK):
         raise ValueError(f"{argument} {path}: the file is not writable")
     _writable_ancestor(path, argument)
     return path
+
+
+INPUT_NAMES = ("results.csv", "results.json", "eval.json", "config.yml", "curve.csv")
+"""Files a command reads out of the folder it is given (a comparison folder, a run or an entry)."""
 
 
 def check_output_dir(path, argument: str) -> Path:

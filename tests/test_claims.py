@@ -100,6 +100,11 @@ def test_the_command_on_a_comparison_and_its_refusals(tmp_path, capsys):
     assert out.count("\n| ") == 10 and "CR collides most" in out          # ten claims
     assert cli.main(["claims", str(tmp_path / "nothing")]) == 2
     assert "no results.csv" in capsys.readouterr().err
+    before = (tmp_path / "c" / "results.csv").read_text()                 # its own input is refused
+    assert cli.main(["claims", str(tmp_path / "c"), "--json", str(tmp_path / "c" / "results.csv")]) == 2
+    err = capsys.readouterr().err
+    assert "--json" in err and "is an input of this command" in err
+    assert (tmp_path / "c" / "results.csv").read_text() == before
     assert cli.main(["claims", str(tmp_path / "c"), "--faults-result", str(tmp_path / "c" / "report.md")]) == 2
     assert "not an 'evaluate --json' result" in capsys.readouterr().err
     # compare takes the fault run too, so that the report's table has that row; a bad file

@@ -53,3 +53,21 @@ def test_training_and_a_zoo_policy_on_the_gpu(tmp_path):
     a_gpu, _ = on_gpu.predict(sim)
     a_cpu, _ = on_cpu.predict(sim)
     assert np.mean(a_gpu == a_cpu) > 0.9       # greedy actions agree up to float ties
+
+
+@NEEDS_CUDA
+@pytest.mark.parametrize("precision", ["auto", "bf16"])
+def test_training_on_the_gpu_in_each_precision(tmp_path, precision):
+    """auto is fp32 on a GPU; bf16 trains there too where the GPU has it; both record it."""
+    from patrolsb3.runs import RunFolder
+    from patrolsb3.sb3.train import train
+    if precision == "bf16" and not torch.cuda.is_bf16_supported():
+        pytest.skip("this GPU has no bf16")
+    room = "S....\n.....\n..5..\n....."
+    (tmp_path / "room.txt").write_text(room)
+    hp = {"n_steps": 16, "batch_size": 64, "n_envs": 2, "eval_freq": 0, "checkpoint_freq": 10**9,
+          "precision": precision, "env": {"episode_steps": 20},
+          "policy_kwargs": {"dense_sizes": [32, 16], "lstm_hidden_size": 8}}
+    run = train(map=str(tmp_path / "room.txt"), variant="rl-msg", timesteps=640, run_dir=tmp_path / "run",
+                hyperparams=hp, progress_bar=False, device="cuda")
+    assert RunFolder(run).read_config()["hyperparams"]["precision"] == ("fp32" if precision == "auto" else "bf16")

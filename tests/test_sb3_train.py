@@ -278,7 +278,12 @@ def test_a_run_on_a_shipped_map_records_no_path_of_this_machine(tmp_path):
     ("n_steps=0", "n_steps must be a whole number >= 2"), ("n_epochs=0", "n_epochs"),
     ("batch_size=-4", "batch_size"), ("n_minibatches=0", "n_minibatches"),
     ("learning_rate=fast", "learning_rate"), ("checkpoint_freq=0", "checkpoint_freq"),
-    ("n_epochs=[1,2", "not valid YAML"), ("gamma=x", "gamma must be a number")])
+    ("n_epochs=[1,2", "not valid YAML"), ("gamma=x", "gamma must be a number"),
+    ("gamma=1.5", "gamma must be between 0 and 1, got 1.5"), ("gae_lambda=-0.1", "gae_lambda must be between 0 and 1"),
+    ("clip_range=-0.2", "clip_range must be above 0"), ("clip_range=0", "clip_range must be above 0"),
+    ("max_grad_norm=0", "max_grad_norm must be above 0"), ("vf_coef=-1", "vf_coef must be at least 0"),
+    ("ent_coef=-0.01", "ent_coef must be at least 0"), ("learning_rate=0", "learning_rate must be above 0"),
+    ("learning_rate=drop_2e-4_0", "learning_rate must be above 0"), ("precision=half", "precision must be one of")])
 def test_bad_settings_are_refused_before_a_run_folder_exists(tmp_path, capsys, setting, match):
     from patrolsb3.cli import main
     assert main(["train", "--map", "A", "--timesteps", "400", "--out", str(tmp_path), "--set", setting]) == 2
@@ -313,3 +318,22 @@ def test_resume_trims_the_curve_and_eval_to_the_checkpoint_and_reads_a_cut_cpu_l
     assert steps == sorted(steps) and 9999 not in steps and max(steps) <= 1200
     evals = [(int(r["timesteps"]), r["n_agents"]) for r in read_curve(run / "eval.csv")]
     assert len(evals) == len(set(evals))
+
+
+def test_resume_refuses_other_settings_and_a_missing_config(tmp_path, capsys):
+    run = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
+    for kwargs, match in [({"hyperparams": tiny_hp(n_steps=20)}, "trained with n_steps=10, this run asks for 20"),
+                          ({"hyperparams": tiny_hp(), "seed": 5}, "trained with seed=0, this run asks for 5"),
+                          ({"hyperparams": tiny_hp(env={"episode_steps": 6})}, "differs from this run's in episode_steps")]:
+        with pytest.raises(ValueError, match=match):
+            train(map=ROOM, timesteps=800, run_dir=run, resume=True, progress_bar=False, **kwargs)
+    # the bookkeeping may change: checkpoint_freq, eval_freq, threads, the target
+    train(map=ROOM, timesteps=800, run_dir=run, resume=True, progress_bar=False,
+          hyperparams=tiny_hp(checkpoint_freq=800, torch_threads=1))
+    assert RunFolder(run).read_config()["hyperparams"]["n_steps"] == 10
+    # a target already reached says so and trains nothing
+    train(map=ROOM, timesteps=400, run_dir=run, resume=True, progress_bar=False, hyperparams=tiny_hp())
+    assert "already at 800 agent-steps, at or past the 400 asked for; nothing to train" in capsys.readouterr().err
+    (run / "config.yml").unlink()
+    with pytest.raises(FileNotFoundError, match="config.yml is missing"):
+        train(map=ROOM, timesteps=1200, run_dir=run, resume=True, progress_bar=False, hyperparams=tiny_hp())

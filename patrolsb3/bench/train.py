@@ -73,7 +73,7 @@ def measure(n_rollouts: int = 2, n_steps: int | None = None, seed: int = 0, over
     rows = vec_env.num_envs
     model = cls(policy_cls, vec_env, seed=seed, device=device,
                 **algorithm_kwargs(hp, spec, vec_env.layout, vec_env.phases_per_step, rows))
-    model.policy.precision = resolve_precision(hp.get("precision", "fp32"), model.device.type)
+    model.policy.precision = resolve_precision(hp.get("precision", "auto"), model.device.type)
     timers = {"env_s": 0.0, "forward_s": 0.0, "update_s": 0.0}
     counts = {"useful": 0}
     step = vec_env.step

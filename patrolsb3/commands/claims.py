@@ -18,7 +18,7 @@ def run(args):
     from ..claims import claims, claims_table, read_faults_result, read_figures
     from ..outputs import check_output_file, write_json
     if args.json:
-        check_output_file(args.json, "--json")
+        check_output_file(args.json, "--json", inputs=[args.compare_dir] + ([args.faults_result] if args.faults_result else []))
     figures = read_figures(args.compare_dir)
     if args.guarded:   # the guarded columns stand in for the learned variants; paper-setting ones are left out
         suffix = f":{zoo.GUARDED}"

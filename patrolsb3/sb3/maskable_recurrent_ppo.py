@@ -137,7 +137,12 @@ class MaskableRecurrentPPO(RecurrentPPO):
 
     def collect_rollouts(self, env: VecEnv, callback, rollout_buffer, n_rollout_steps: int) -> bool:
         """RecurrentPPO.collect_rollouts with masks read before each step and stored; the
-        horizon bootstrap of all truncated rows is one batched critic call."""
+        horizon bootstrap of all truncated rows is one batched critic call. In bf16 the
+        weights are cast once for the whole collection (they do not change during it)."""
+        with self.policy.frozen_weights_scope():
+            return self._collect_rollouts(env, callback, rollout_buffer, n_rollout_steps)
+
+    def _collect_rollouts(self, env: VecEnv, callback, rollout_buffer, n_rollout_steps: int) -> bool:
         assert self._last_obs is not None, "No previous observation was provided"
         if not is_masking_supported(env) and not callable(getattr(env, "action_masks", None)):
             raise ValueError("MaskableRecurrentPPO needs an env with action_masks() (patrolsb3.sb3.make_vec_env "

@@ -114,6 +114,15 @@ class _RoleExtractorMixin:
         """The context the trunks (convolutions, Dense stack, LSTM) run in."""
         return autocast(self.precision, self.device.type)
 
+    def frozen_weights_scope(self):
+        """A context for a stretch where the weights do not change (a rollout's collection):
+        bf16 copies of the weights are cast once and kept until it ends, instead of once per
+        forward pass (autocast's weight cache lives until the outermost autocast context
+        exits; this one is disabled, so nothing else in it changes precision)."""
+        if self.precision == "fp32":
+            return contextlib.nullcontext()
+        return th.autocast(device_type=self.device.type, enabled=False)
+
     @contextlib.contextmanager
     def full_precision(self):
         """Within it, the trunks compute in fp32 whatever the run's precision (prediction)."""

@@ -10,6 +10,7 @@ in the hyperparameters and converted per env step (``gamma ** (1 / phases_per_st
 """
 from __future__ import annotations
 
+import math
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -167,6 +168,35 @@ def algorithm_kwargs(hp: dict, spec, layout, phases_per_step: int, rows: int, ep
                 policy_kwargs=policy_kwargs_for(layout, **policy_kwargs), **extra)
 
 
+NUMBER_RANGES = {"gamma": (0.0, 1.0, True), "gae_lambda": (0.0, 1.0, True), "clip_range": (0.0, math.inf, False),
+                 "max_grad_norm": (0.0, math.inf, False), "vf_coef": (0.0, math.inf, True),
+                 "ent_coef": (0.0, math.inf, True)}
+"""(low, high, low included) of the PPO numbers: discounts in [0, 1], a clip range and a gradient
+norm above 0, coefficients at least 0."""
+
+
+def _in_range(value: float, low: float, high: float, low_included: bool) -> bool:
+    return (value >= low if low_included else value > low) and value <= high and not math.isnan(value)
+
+
+def _range_text(low: float, high: float, low_included: bool) -> str:
+    if math.isinf(high):
+        return f"{'at least' if low_included else 'above'} {low:g}"
+    return f"between {low:g} and {high:g}"
+
+
+def _schedule_values(value) -> list[float]:
+    """The rates a learning-rate setting takes (a number, lin_<v>'s start, drop_<v>_<w>'s two)."""
+    text = str(value)
+    if isinstance(value, (int, float)):
+        return [float(value)]
+    if text.startswith("lin_"):
+        return [float(text[4:])]
+    if text.startswith("drop_"):
+        return [float(v) for v in text[5:].split("_")]
+    return [float(text)]
+
+
 def check_run_settings(hp: dict, total) -> None:
     """Refuse, before any work and before the run folder exists, the settings that would fail
     later or train nothing: counts below their minimum, a learning rate that is not a number
@@ -196,11 +226,16 @@ def check_run_settings(hp: dict, total) -> None:
             continue                                    # optional, off by default
         elif isinstance(hp.get(key), bool) or not isinstance(hp.get(key), (int, float)):
             raise ValueError(f"{key} must be a number, got {hp.get(key)!r}")
+        elif key in NUMBER_RANGES and not _in_range(hp[key], *NUMBER_RANGES[key]):
+            raise ValueError(f"{key} must be {_range_text(*NUMBER_RANGES[key])}, got {hp[key]!r}")
+    rates = _schedule_values(hp["learning_rate"])
+    if any(not rate > 0 or math.isinf(rate) or math.isnan(rate) for rate in rates):
+        raise ValueError(f"learning_rate must be above 0 (every value of a schedule), got {hp['learning_rate']!r}")
     for key in COMMUNICATION_KEYS:
         if hp.get(key) is not None and get_algorithm(hp.get("algo", DEFAULT_ALGORITHM)).name \
                 != "MaskableRecurrentPPO":
             raise ValueError(f"{key} is a setting of MaskableRecurrentPPO, not of {hp.get('algo')}")
-    if hp.get("precision", "fp32") not in PRECISIONS:
+    if hp.get("precision", "auto") not in PRECISIONS:
         raise ValueError(f"precision must be one of {', '.join(PRECISIONS)}, got {hp.get('precision')!r}")
     if hp.get("message_team_share") is not None and not 0.0 <= float(hp["message_team_share"]) <= 1.0:
         raise ValueError(f"message_team_share must be between 0 and 1 (a share of the team's reward), got "
@@ -231,9 +266,23 @@ def normalized_rewards(vec_env, checkpoint: Path | None, gamma: float):
     return VecNormalize(vec_env, norm_obs=False, norm_reward=True, gamma=gamma)
 
 
+RESUME_FREE = ("timesteps", "checkpoint_freq", "eval_freq", "eval_episode_steps", "eval_episodes", "torch_threads",
+               "precision")
+"""Hyperparameters a resumed run may change: the target, the bookkeeping and the machine's
+threads (``precision`` is the run's own: :func:`run_precision`). Any other differs from the
+run's config.yml only by a refusal."""
+
+
 def _check_resumable(run: RunFolder, config: dict) -> Path:
-    """The newest valid checkpoint of a run folder whose config matches this run's map and env
-    (newer invalid ones are named on stderr and passed over)."""
+    """The newest valid checkpoint of a run folder whose config.yml matches this run's map,
+    variant, algorithm, seed, env and hyperparameters (newer invalid checkpoints are named on
+    stderr and passed over).
+
+    Raises:
+        FileNotFoundError: no valid checkpoint, or no config.yml (nothing to check the settings
+            against).
+        ValueError: a setting other than the run's (one line naming it and both values).
+    """
     skipped = []
     checkpoint = run.newest_checkpoint(skipped)
     for path in skipped:
@@ -242,18 +291,29 @@ def _check_resumable(run: RunFolder, config: dict) -> Path:
     if checkpoint is None:
         raise FileNotFoundError(f"--resume: no valid checkpoint found in {run.checkpoints_dir} "
                                 f"(looked for model_<steps>_steps.zip)")
-    if run.config_file.is_file():
-        saved = run.read_config()
-        for key in ("map", "map_shape", "variant", "algo"):
-            if saved.get(key) != config[key]:
-                raise ValueError(f"--resume: {run_dir} was trained with {key}={saved.get(key)!r}, "
-                                 f"this run asks for {config[key]!r}")
-        if saved.get("versions", {}).get("env_version") != config["versions"]["env_version"]:
-            raise ValueError(f"--resume: {run_dir} was trained on env version "
-                             f"{saved.get('versions', {}).get('env_version')!r}, this package has "
-                             f"{config['versions']['env_version']!r}")
-        if saved.get("env") != config["env"]:
-            raise ValueError(f"--resume: the env config of {run_dir} differs from this run's")
+    if not run.config_file.is_file():
+        raise FileNotFoundError(f"--resume: {run.config_file} is missing, so this run's settings cannot be checked "
+                                f"against the run's; restore it, or start a new run from the checkpoint with "
+                                f"--init-from {checkpoint}")
+    saved = run.read_config()
+    for key in ("map", "map_shape", "variant", "algo", "seed"):
+        if saved.get(key) != config[key]:
+            raise ValueError(f"--resume: {run_dir} was trained with {key}={saved.get(key)!r}, "
+                             f"this run asks for {config[key]!r}")
+    if saved.get("versions", {}).get("env_version") != config["versions"]["env_version"]:
+        raise ValueError(f"--resume: {run_dir} was trained on env version "
+                         f"{saved.get('versions', {}).get('env_version')!r}, this package has "
+                         f"{config['versions']['env_version']!r}")
+    if saved.get("env") != config["env"]:
+        changed = sorted(k for k in set(saved.get("env") or {}) | set(config["env"])
+                         if (saved.get("env") or {}).get(k) != config["env"].get(k))
+        raise ValueError(f"--resume: the env config of {run_dir} differs from this run's in {', '.join(changed)}")
+    old_hp, new_hp = saved.get("hyperparams") or {}, config["hyperparams"]
+    for key in sorted(set(old_hp) & set(new_hp) - set(RESUME_FREE)):
+        if old_hp[key] != new_hp[key]:
+            raise ValueError(f"--resume: {run_dir} was trained with {key}={old_hp[key]!r}, this run asks for "
+                             f"{new_hp[key]!r}; resume with the run's settings (its config.yml), or start a new "
+                             f"run from its weights with --init-from")
     return checkpoint
 
 
@@ -262,7 +322,7 @@ def run_precision(hp: dict, device_type: str, resumed: RunFolder | None = None) 
     resolved on this device (:func:`patrolsb3.sb3.precision.resolve_precision`); a resumed run
     keeps the one its config.yml records (``fp32`` when it records none: runs from before the
     setting existed), and says so on stderr when the hyperparameters asked for another."""
-    wanted = resolve_precision(hp.get("precision", "fp32"), device_type)
+    wanted = resolve_precision(hp.get("precision", "auto"), device_type)
     if resumed is None or not resumed.config_file.is_file():
         return wanted
     kept = (resumed.read_config().get("hyperparams") or {}).get("precision", "fp32")
@@ -449,6 +509,9 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     callbacks, curve, cpu_time = _callbacks(spec_map, variant, spec, hp, seed, teams, total, run, model,
                                             vec_env, resumed=checkpoint is not None)
     remaining = total - model.num_timesteps
+    if remaining <= 0 and checkpoint is not None:
+        print(f"--resume: {run.path} is already at {model.num_timesteps:,} agent-steps, at or past the "
+              f"{total:,} asked for; nothing to train (raise --timesteps to train further)", file=sys.stderr)
     try:
         if remaining > 0:
             model.learn(remaining, callback=CallbackList(callbacks), reset_num_timesteps=checkpoint is None,
