@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -508,7 +509,24 @@ def load_entry(folder, spec=None, device: str = "cpu") -> ZooPolicy:
     return ZooPolicy(policy, spec, cfg, info)
 
 
-def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, as_seed: bool = False) -> Path:
+def export_destination(run_dir, zoo_dir=None, as_seed: bool = False) -> Path:
+    """The entry folder :func:`export` writes a run into (module docstring of :func:`export`).
+
+    Raises:
+        ZooError: the run folder has no config.yml.
+    """
+    from .runs import RunFolder
+    run = RunFolder(run_dir)
+    if not run.config_file.is_file():
+        raise ZooError(f"{run.path}: no config.yml; not a run folder of 'patrolsb3 train'")
+    config = run.read_config()
+    guard = bool((config.get("env") or {}).get("return_guard"))
+    return entry_dir(config["map"], config["variant"], zoo_dir, guard=guard,
+                     seed=config.get("seed", 0) if as_seed or not guard else None)
+
+
+def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, as_seed: bool = False,
+           into=None) -> Path:
     """Copy a training run into the zoo, keeping the policy only (no optimizer).
 
     Args:
@@ -523,6 +541,8 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
         as_seed: for a run behind the return guard, write into the guarded entry's ``seed<k>``
             subfolder (k: the run's training seed) instead of its default folder. A run in the
             paper's setting always goes to ``zoo/<MAP>/<variant>/seed<k>/``.
+        into: write into this folder instead (a staging folder: ``patrolsb3 zoo export`` builds
+            the whole entry there, then swaps it in; :func:`replace_entry`).
 
     Returns:
         The entry folder: ``zoo/<MAP>/<variant>/seed<k>`` for a run in the paper's setting (no
@@ -546,9 +566,7 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
     from .sb3.algorithms import get_algorithm
     algo_class, _ = get_algorithm(config["algo"]).classes()
     model = algo_class.load(str(source), device="cpu")
-    guard = bool((config.get("env") or {}).get("return_guard"))
-    folder = entry_dir(config["map"], config["variant"], zoo_dir, guard=guard,
-                       seed=config.get("seed", 0) if as_seed or not guard else None)
+    folder = Path(into) if into is not None else export_destination(run_dir, zoo_dir, as_seed)
     folder.mkdir(parents=True, exist_ok=True)
     write_atomically(folder / "model.zip", lambda partial: model.policy.save(str(partial)))
     for name in (run.COMMAND, *run.RECORDS):
@@ -572,6 +590,20 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
     text = yaml.safe_dump(config, sort_keys=False)
     write_atomically(folder / "config.yml", lambda partial: partial.write_text(text))
     return folder
+
+
+def replace_entry(staged: Path, entry: Path) -> None:
+    """Put a complete staged entry in place of ``entry`` in one step: the old entry (its model and
+    every figure of it: eval.json, listening.json, ablation files) is moved aside, the staged one
+    renamed in, then the old one deleted; a new model never stands beside old figures."""
+    import shutil
+    staged, entry = Path(staged), Path(entry)
+    old = entry.with_name(f".{entry.name}.old-{os.getpid()}")
+    if entry.exists():
+        entry.rename(old)
+    staged.rename(entry)
+    if old.exists():
+        shutil.rmtree(old)
 
 
 def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, steps: int, seed: int,

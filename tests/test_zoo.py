@@ -420,3 +420,41 @@ def test_a_card_without_message_figures_has_no_messages_section(trained):
     from patrolsb3.zoo_cards import card
     entry = zoo.read_entry(trained["folder"])
     assert "What its messages carry" not in card(entry)
+
+
+def test_the_export_command_refuses_an_existing_entry_and_never_leaves_old_figures_beside_a_new_model(
+        trained, tmp_path, capsys, monkeypatch):
+    import shutil
+
+    from patrolsb3 import cli, evaluate
+    zoo_dir = tmp_path / "zoo"
+    common = ["zoo", "export", str(trained["run"]), "--zoo-dir", str(zoo_dir)]
+    assert cli.main(common + ["--episodes", "1", "--steps", "20"]) == 0
+    entry = zoo_dir / "ROOM" / "rl-msg" / "seed0"
+    (entry / "listening.json").write_text("{}")             # a figure of this model
+    model = (entry / "model.zip").read_bytes()
+    capsys.readouterr()
+    # an existing entry: refused in one line, nothing touched
+    assert cli.main(common + ["--episodes", "1", "--steps", "20"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "is an entry already; pass --overwrite" in err and len(err.splitlines()) == 1
+    # bad arguments are refused before anything is written, --overwrite or not
+    for bad in (["--episodes", "0"], ["--steps", "-5"], ["--seed", "-1"], ["--checkpoint", str(tmp_path / "none.zip")]):
+        assert cli.main(common + ["--overwrite"] + bad) == 2
+        assert bad[0] in capsys.readouterr().err
+    # an evaluation that fails half-way (Ctrl-C) leaves the old entry whole, figures included
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(evaluate, "write_zoo_eval", interrupted)
+    assert cli.main(common + ["--overwrite", "--episodes", "1", "--steps", "20"]) != 0
+    assert "interrupted" in capsys.readouterr().err
+    assert (entry / "model.zip").read_bytes() == model and (entry / "listening.json").is_file()
+    assert sorted(p.name for p in entry.parent.iterdir()) == ["seed0"]           # no staging left
+    monkeypatch.undo()
+    # --overwrite replaces the entry whole: the old model's figures go with it
+    other = tmp_path / "other_run"
+    shutil.copytree(trained["run"], other)
+    assert cli.main(["zoo", "export", str(other), "--zoo-dir", str(zoo_dir), "--overwrite", "--episodes", "1",
+                     "--steps", "20"]) == 0
+    assert not (entry / "listening.json").exists() and (entry / "eval.json").is_file()
+    assert str(other) in yaml.safe_load((entry / "config.yml").read_text())["source_run"]

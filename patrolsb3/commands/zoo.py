@@ -36,6 +36,9 @@ def add_arguments(parser):
     p_export.add_argument("--stochastic", action="store_true",
                           help="evaluate with sampled actions (default: the most likely legal action)")
     p_export.add_argument("--no-eval", action="store_true", help="copy only, no eval.json")
+    p_export.add_argument("--overwrite", action="store_true",
+                          help="replace an existing entry (its model and every figure of it: eval, listening, "
+                               "ablation); without it an existing entry is refused")
     p_export.add_argument("--as-seed", action="store_true",
                           help="export into the entry's seed<k> subfolder (k: the run's seed), not its default")
     p_val = sub.add_parser("validate", help="evaluate every checkpoint of a run on a short greedy protocol "
@@ -218,17 +221,40 @@ def run(args):
 
 
 def export_and_evaluate(args) -> int:
-    """``patrolsb3 zoo export``: copy the run, then write eval.json (paper metrics, n = 1..5)."""
+    """``patrolsb3 zoo export``: every argument checked, then the run copied and evaluated
+    (eval.json, paper metrics, n = 1..5) in a staging folder beside the entry, which replaces
+    the entry only once complete: an interrupted or failed export leaves the old entry whole."""
+    import os
+    import shutil
+
     from ..evaluate import write_zoo_eval
-    from ..zoo import export
+    from ..zoo import ZooError, export, export_destination, replace_entry
+    for name, value, low in (("--episodes", args.episodes, 1), ("--steps", args.steps, 1), ("--seed", args.seed, 0)):
+        if value < low:
+            raise ValueError(f"{name} must be a whole number >= {low}, got {value}")
+    if args.cpu_hours is not None and not args.cpu_hours >= 0:
+        raise ValueError(f"--cpu-hours must be a number >= 0, got {args.cpu_hours}")
+    if args.checkpoint is not None and not os.path.isfile(args.checkpoint):
+        raise ValueError(f"--checkpoint {args.checkpoint}: no such file")
+    entry = export_destination(args.run_dir, zoo_dir=args.zoo_dir, as_seed=args.as_seed)
+    if (entry / "model.zip").exists() and not args.overwrite:
+        raise ZooError(f"{entry} is an entry already; pass --overwrite to replace it (its model and every "
+                       f"figure of it), or export with another --zoo-dir")
+    staged = entry.with_name(f".{entry.name}.export-{os.getpid()}")
     budget = {"cpu_hours": args.cpu_hours} if args.cpu_hours is not None else {}
-    folder = export(args.run_dir, zoo_dir=args.zoo_dir, budget=budget, checkpoint=args.checkpoint,
-                    as_seed=args.as_seed)
-    print(f"exported to {folder}")
+    try:
+        export(args.run_dir, zoo_dir=args.zoo_dir, budget=budget, checkpoint=args.checkpoint,
+               as_seed=args.as_seed, into=staged)
+        if not args.no_eval:
+            write_zoo_eval(staged, episodes=args.episodes, steps=args.steps, seed=args.seed,
+                           deterministic=not args.stochastic)
+        replace_entry(staged, entry)
+    finally:
+        if staged.exists():
+            shutil.rmtree(staged)
+    print(f"exported to {entry}")
     if not args.no_eval:
-        path = write_zoo_eval(folder, episodes=args.episodes, steps=args.steps, seed=args.seed,
-                          deterministic=not args.stochastic)
-        print(f"evaluation written to {path}")
+        print(f"evaluation written to {entry / 'eval.json'}")
     return 0
 
 
