@@ -33,6 +33,10 @@ CHECKPOINT_RE = re.compile(r"model_(\d+)_steps\.zip$")
 """A checkpoint's file name: ``checkpoints/model_<agent-steps>_steps.zip`` (SB3's CheckpointCallback)."""
 
 
+class RunFolderBusy(ValueError):
+    """A run folder another process is writing (:meth:`RunFolder.lock`)."""
+
+
 class ConfigError(ValueError):
     """A config.yml that cannot be read (not YAML, not a mapping)."""
 
@@ -263,10 +267,31 @@ class RunFolder:
         """The reward statistics saved with the checkpoint of ``timesteps``."""
         return self.checkpoints_dir / self.STATISTICS.format(int(timesteps))
 
+    LOCK = ".lock"
+    """The lock file of the process writing the run (:meth:`lock`); not part of the run."""
+
     # -- state ---------------------------------------------------------------------------------
     def has_files(self) -> bool:
-        """True when the folder exists and holds anything (a new run must not write into it)."""
-        return self.path.is_dir() and any(self.path.iterdir())
+        """True when the folder exists and holds anything but its lock file (a new run must not
+        write into it)."""
+        return self.path.is_dir() and any(p.name != self.LOCK for p in self.path.iterdir())
+
+    def lock(self):
+        """Hold the run folder for this process: a ``filelock`` lock on ``<run>/.lock``, held
+        until it is released (``with folder.lock(): ...`` or ``.release()``), or the process ends.
+
+        Raises:
+            RunFolderBusy: another process holds it (one line naming the folder).
+        """
+        from filelock import FileLock, Timeout
+        self.path.mkdir(parents=True, exist_ok=True)
+        lock = FileLock(self.path / self.LOCK)
+        try:
+            lock.acquire(timeout=0)
+        except Timeout:
+            raise RunFolderBusy(f"{self.path} is being written by another process (a train, sweep or resume of "
+                                f"the same run); wait for it to end, or use another --run-id") from None
+        return lock
 
     def create(self) -> None:
         """Make the folder and its checkpoints folder."""
@@ -317,7 +342,7 @@ class RunFolder:
         Raises:
             ValueError: ``keep`` is below 1.
             FileNotFoundError: no valid checkpoint, or the statistics file of one to copy is
-                missing (names it).
+                missing in a run that normalises its rewards (names it).
             FileExistsError: the run has finished (``model.zip``): it is not resumed, and a
                 snapshot would drop the older checkpoints that choosing one by validation reads.
         """
@@ -331,12 +356,17 @@ class RunFolder:
         # kept: newest first, at most `keep` paths
         if not kept:
             raise FileNotFoundError(f"{self.path}: no valid checkpoint to snapshot")
+        # a run that normalises its rewards is resumed with the statistics beside its checkpoint
+        normalized = not self.config_file.is_file() or bool(
+            (self.read_config().get("hyperparams") or {}).get("normalize_reward", True))
         sources = []
         for checkpoint in kept:
             statistics = self.statistics_file(model_steps(checkpoint))
-            if not statistics.is_file():
+            if statistics.is_file():
+                sources.append(statistics)
+            elif normalized:
                 raise FileNotFoundError(f"{statistics}: missing (a checkpoint is resumed with its statistics)")
-            sources += [checkpoint, statistics]
+            sources.append(checkpoint)
         target = RunFolder(dest)
         if target.path.exists():
             shutil.rmtree(target.path)

@@ -211,7 +211,7 @@ def trial_state(trial: Trial) -> str:
         return "finished"
     if run.newest_checkpoint() is not None:
         return "resumable"
-    return "blocked" if run.path.is_dir() and any(run.path.iterdir()) else "new"
+    return "blocked" if run.has_files() else "new"
 
 
 BLOCKED = ("its run folder {} exists with files but no checkpoint to resume; the sweep does not replace it "
@@ -232,8 +232,9 @@ def run_trial(trial: Trial, torch_threads: int = 1) -> dict:
     state = trial_state(trial)
     if state == "blocked":
         raise ValueError(BLOCKED.format(trial.run_dir))
-    if state == "new" and trial.run_dir.exists():
-        trial.run_dir.rmdir()                           # empty: train makes it again
+    if state == "new" and trial.run_dir.exists():     # empty but for a lock file: train makes it again
+        (trial.run_dir / RunFolder.LOCK).unlink(missing_ok=True)
+        trial.run_dir.rmdir()
     if state != "finished":
         hyperparams = merge({"torch_threads": int(torch_threads)}, trial.overrides)
         train(map=trial.map, variant=trial.variant, timesteps=trial.timesteps, seed=trial.seed,

@@ -68,6 +68,8 @@ def test_a_snapshot_holds_the_newest_valid_checkpoint_with_its_statistics_and_re
     with pytest.raises(FileNotFoundError, match="model_vecnormalize_800_steps.pkl"):
         run.snapshot(tmp_path / "snap2")
     assert not (tmp_path / "snap2").exists()                        # refused before any copy
+    run.config_file.write_text("map: A\nhyperparams: {normalize_reward: false}\n")    # no statistics to carry
+    assert run.snapshot(tmp_path / "snap2") == RunFolder(tmp_path / "snap2").checkpoint_file(800)
     with pytest.raises(FileNotFoundError, match="no valid checkpoint"):
         RunFolder(tmp_path / "empty").snapshot(tmp_path / "snap3")
 
@@ -86,6 +88,8 @@ def test_a_snapshot_keeps_the_newest_k_valid_checkpoints_when_asked(tmp_path):
     with pytest.raises(FileNotFoundError, match="model_vecnormalize_800_steps.pkl"):
         run.snapshot(tmp_path / "snap2", keep=3)
     assert not (tmp_path / "snap2").exists()                        # refused before any copy
+    run.config_file.write_text("map: A\nhyperparams: {normalize_reward: false}\n")    # no statistics to carry
+    assert run.snapshot(tmp_path / "snap2") == RunFolder(tmp_path / "snap2").checkpoint_file(1600)
     for bad in (0, -1, 1.5, True):
         with pytest.raises(ValueError, match="keep: "):
             run.snapshot(tmp_path / "snap3", keep=bad)

@@ -155,9 +155,10 @@ def test_reward_normalisation_saves_and_resumes_its_statistics(tmp_path):
 def test_init_from_starts_a_new_run_from_the_weights(tmp_path):
     source = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
     src_weights = MaskableRecurrentPPO.load(source / "model.zip", device="cpu").policy.state_dict()
-    # lr 0 and no curriculum: the warm-started run must keep exactly the source's weights
+    # lr 1e-50 (0 is refused; this is below float32's smallest number, so no weight moves) and no
+    # curriculum: the warm-started run must keep exactly the source's weights
     run = train(map=ROOM, timesteps=400, out=tmp_path, run_id="warm", init_from=source, progress_bar=False,
-                hyperparams=tiny_hp(learning_rate=0.0, curriculum=False))
+                hyperparams=tiny_hp(learning_rate=1e-50, curriculum=False))
     model = MaskableRecurrentPPO.load(run / "model.zip", device="cpu")
     assert model.num_timesteps == 400                                   # a fresh step count
     for name, value in model.policy.state_dict().items():
@@ -171,7 +172,7 @@ def test_init_from_starts_a_new_run_from_the_weights(tmp_path):
     assert yaml.safe_load((third / "config.yml").read_text())["init_from"]["timesteps"] == 800
     # a fresh run from random weights differs from the source
     fresh = train(map=ROOM, timesteps=400, out=tmp_path, run_id="fresh", seed=3, progress_bar=False,
-                  hyperparams=tiny_hp(learning_rate=0.0))
+                  hyperparams=tiny_hp(learning_rate=1e-50))
     fresh_weights = MaskableRecurrentPPO.load(fresh / "model.zip", device="cpu").policy.state_dict()
     assert any(not th.equal(v, src_weights[k]) for k, v in fresh_weights.items())
     # a run stopped early (no model.zip): its newest checkpoint
@@ -337,3 +338,17 @@ def test_resume_refuses_other_settings_and_a_missing_config(tmp_path, capsys):
     (run / "config.yml").unlink()
     with pytest.raises(FileNotFoundError, match="config.yml is missing"):
         train(map=ROOM, timesteps=1200, run_dir=run, resume=True, progress_bar=False, hyperparams=tiny_hp())
+
+
+def test_a_run_folder_is_written_by_one_process_at_a_time(tmp_path, capsys):
+    run = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
+    curve = (run / "curve.csv").read_text()
+    held = RunFolder(run).lock()                 # as another process running --resume would
+    try:
+        with pytest.raises(ValueError, match="is being written by another process"):
+            train(map=ROOM, timesteps=800, run_dir=run, hyperparams=tiny_hp(), resume=True, progress_bar=False)
+    finally:
+        held.release()
+    assert (run / "curve.csv").read_text() == curve       # nothing written while it was held
+    train(map=ROOM, timesteps=800, run_dir=run, hyperparams=tiny_hp(), resume=True, progress_bar=False)
+    assert RunFolder(run).has_files() and not RunFolder(tmp_path / "empty").has_files()

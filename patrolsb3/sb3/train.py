@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from stable_baselines3.common.callbacks import CheckpointCallback
+from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
 from stable_baselines3.common.vec_env import VecNormalize
 
 from ..core.config import EnvConfig
@@ -468,7 +468,6 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
         FileNotFoundError: ``resume`` without a checkpoint (names where it looked).
     """
     import torch
-    from stable_baselines3.common.callbacks import CallbackList
 
     from ..core.maps import source_label
 
@@ -499,7 +498,23 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
                                   config, run, device, verbose)
     model.policy.precision = run_precision(hp, model.device.type, run if checkpoint is not None else None)
     config["hyperparams"] = {**hp, "precision": model.policy.precision}
-    # every setting has been accepted (the model is built): now the run folder is made
+    # every setting has been accepted (the model is built): now the run folder is made, and held
+    folder_lock = run.lock()
+    try:
+        return _train_in_folder(run, model, vec_env, checkpoint, resume, config, command, spec_map, variant, spec,
+                                hp, seed, teams, total, progress_bar, cfg)
+    finally:
+        folder_lock.release()
+
+
+def _train_in_folder(run: RunFolder, model, vec_env, checkpoint, resume: bool, config: dict, command, spec_map,
+                     variant: str, spec, hp: dict, seed: int, teams, total: int, progress_bar: bool, cfg) -> Path:
+    """The part of :func:`train` that writes the run folder, while this process holds it."""
+    if checkpoint is None and run.has_files():    # another process made it after our first look
+        raise ValueError(f"run folder {run.path} exists; pass --resume to continue it or --run-id to start another")
+    if checkpoint is not None and run.newest_checkpoint() != checkpoint:
+        raise ValueError(f"--resume: {run.path} changed while this run was being set up (another process "
+                         f"wrote a checkpoint); run --resume again")
     run.create()
     if checkpoint is not None:
         run.cut_back_to(model.num_timesteps)    # the abandoned stretch after the checkpoint goes
