@@ -70,9 +70,17 @@ class ResultStore:
 
     def add(self, result: dict) -> None:
         """Store a result (replacing one with the same protocol) and write the file at once, so
-        an interrupted comparison keeps what it finished."""
+        an interrupted comparison keeps what it finished. The file is merged, not overwritten:
+        under a lock (``.results.lock`` beside it) the results another ``compare`` on the same
+        folder stored meanwhile are read back first, so two comparisons on one ``--out`` keep
+        both's results."""
+        from filelock import FileLock
         result = {**result, "env_version": result.get("env_version", ENV_VERSION)}
         key = protocol(result)
-        self.results = [r for r in self.results if protocol(r) != key] + [result]
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        write_json(self.path, self.results)
+        with FileLock(self.path.with_name(".results.lock")):
+            stored = ResultStore(self.path.parent).results if self.path.is_file() else []
+            mine = {protocol(r) for r in self.results}
+            merged = [r for r in stored if protocol(r) not in mine] + self.results
+            self.results = [r for r in merged if protocol(r) != key] + [result]
+            write_json(self.path, self.results)

@@ -29,8 +29,18 @@ def test_a_stored_result_stands_only_for_the_same_protocol(tmp_path):
     learned = {**result, "strategy": "zoo:rl-msg"}
     again.add(learned)
     assert again.find({**learned, "deterministic": False}) is None
-    store.add(result)                                             # the same protocol replaces, not duplicates
-    assert len(json.loads((tmp_path / "results.json").read_text())) == 1
+    store.add(result)                 # the same protocol replaces, not duplicates; `again`'s result stays
+    assert [r["strategy"] for r in json.loads((tmp_path / "results.json").read_text())] == ["zoo:rl-msg", "CR"]
+
+
+def test_two_comparisons_on_one_folder_keep_both_results(tmp_path):
+    first, second = ResultStore(tmp_path), ResultStore(tmp_path)   # opened together, as two commands would
+    cr = evaluate("CR", "A", 1, episodes=1, steps=20, seed=0, progress=False)
+    sebs = evaluate("SEBS", "A", 1, episodes=1, steps=20, seed=0, progress=False)
+    first.add(cr)
+    second.add(sebs)
+    stored = ResultStore(tmp_path)
+    assert stored.find(cr) is not None and stored.find(sebs) is not None
 
 
 def test_a_result_stored_before_an_env_field_existed_stands_for_its_default(tmp_path):
