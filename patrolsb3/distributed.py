@@ -123,8 +123,11 @@ def sweep_on_ray(trials, cpus_per_trial: int = 1, storage: Path | None = None,
         run_config=tune.RunConfig(name=time.strftime("sweep-%Y%m%d-%H%M%S"), storage_path=str(Path(root).resolve()),
                                   verbose=0, callbacks=[ProgressLines()],
                                   failure_config=tune.FailureConfig(max_failures=0)))
-    outcome = {}
+    outcome = {t.name: {"status": "error", "seconds": 0.0, "error": "Ray returned no result for this trial"}
+               for t in trials}
     for result in tuner.fit():
+        if not result.config:            # a trial whose record Ray could not read back: stays an error
+            continue
         trial = by_index[result.config["trial"]]
         metrics = result.metrics or {}
         error = _cause(result.error) if result.error else ""
