@@ -148,13 +148,39 @@ class PatrolParallelEnv(ParallelEnv):
         self._decide(protocol.first_phase(self.cfg))
         return self._observations(), self._infos(None)
 
+    def _checked_action(self, name: str, action) -> np.ndarray:
+        """One agent's action as (2,) int64: a pair of whole numbers, or a ValueError naming it."""
+        value = np.asarray(action)
+        if value.shape != (2,) or value.dtype == object or not np.issubdtype(value.dtype, np.number):
+            raise ValueError(f"step(): the action of {name} must be a (message, move) pair of whole numbers, "
+                             f"got {action!r}")
+        if np.issubdtype(value.dtype, np.floating) and not (np.all(np.isfinite(value))
+                                                          and np.all(value == np.round(value))):
+            raise ValueError(f"step(): the action of {name} must be whole numbers, got {action!r}")
+        return value.astype(np.int64)
+
     def step(self, actions):
-        """Apply one (message, move) action per agent; see the class docstring for phases."""
+        """Apply one (message, move) action per agent; see the class docstring for phases.
+
+        Raises:
+            RuntimeError: step before reset, or after the episode ended.
+            TypeError: ``actions`` is not a dict.
+            ValueError: an agent not in the episode, or an action that is not a pair of whole
+                numbers (illegal values are the masks' business: ``invalid_action``).
+        """
+        if self.core_state is None:
+            raise RuntimeError("step() before reset(): call reset() to start an episode")
+        if not isinstance(actions, dict):
+            raise TypeError(f"step() takes a dict {{agent: (message, move)}}, got {type(actions).__name__}")
+        if actions and not self.agents:
+            raise RuntimeError("step(): the episode has ended; call reset() to start another")
+        if unknown := sorted(set(actions) - set(self.agents)):
+            raise ValueError(f"step(): unknown agent(s) {unknown}; this episode's agents are {self.agents}")
         act = np.zeros((1, self.cfg.max_agents, 2), dtype=np.int64)             # (1, A, 2)
         act[0, :, 1] = STAY                                                    # slots not deployed
         for i, name in enumerate(self.agents):
             if name in actions and actions[name] is not None:
-                act[0, i] = np.asarray(actions[name], dtype=np.int64).reshape(2)
+                act[0, i] = self._checked_action(name, actions[name])
         phase = self.phase
         act = protocol.check_actions(self.cfg, phase, act, self._decision.masks)
         info = protocol.apply_actions(self.spec_map, self.cfg, self.core_state, phase, act,
@@ -226,6 +252,8 @@ class PatrolParallelEnv(ParallelEnv):
         """An RGB frame (H_px, W_px, 3) uint8 in 'rgb_array' mode; a window in 'human' mode."""
         if self.render_mode is None:
             raise ValueError("render() needs render_mode='rgb_array' or 'human' at construction")
+        if self.core_state is None:
+            raise RuntimeError("render() before reset(): call reset() to start an episode")
         from .render import render_frame, show_frame
         frame = render_frame(self.spec_map, self.cfg, self.core_state)
         if self.render_mode == "human":

@@ -201,3 +201,25 @@ def test_delayed_messages_out_of_range_are_refused_or_repaired_and_obs_stay_in_t
     obs, *_ = lenient.step({"drone_0": (40, STAY), "drone_1": (-3, STAY)})
     obs, *_ = lenient.step({"drone_0": (0, STAY), "drone_1": (0, STAY)})
     assert all(lenient.observation_space(a).contains(o) for a, o in obs.items())
+
+
+def test_misuse_of_the_env_is_refused_by_name():
+    env = patrolsb3.parallel_env(map="A", n_agents=2, render_mode="rgb_array")
+    with pytest.raises(RuntimeError, match=r"step\(\) before reset\(\)"):
+        env.step({"drone_0": (0, STAY)})
+    with pytest.raises(RuntimeError, match=r"render\(\) before reset\(\)"):
+        env.render()
+    env.reset(seed=0)
+    with pytest.raises(TypeError, match=r"takes a dict \{agent: \(message, move\)\}, got list"):
+        env.step([(0, 0), (0, 0)])
+    with pytest.raises(ValueError, match=r"unknown agent\(s\) \['drone_4'\]"):
+        env.step({"drone_0": (0, STAY), "drone_4": (0, STAY)})
+    for bad in ((0.5, 0), (float("nan"), 0), (0, 0, 0), "up", (None, 1)):
+        with pytest.raises(ValueError, match="the action of drone_1 must be"):
+            env.step({"drone_0": (0, STAY), "drone_1": bad})
+    assert env.render().ndim == 3
+    obs, *_ = env.step({"drone_0": np.array([0.0, float(STAY)]), "drone_1": np.array([0, STAY])})   # whole floats are fine
+    assert set(obs) == {"drone_0", "drone_1"}
+    env.agents = []                                            # as after the last step of an episode
+    with pytest.raises(RuntimeError, match="the episode has ended"):
+        env.step({"drone_0": (0, STAY)})

@@ -217,3 +217,10 @@ def test_a_corridor_full_of_patrolling_agents_empties_for_an_agent_heading_home(
     for _ in run(strategies.get(name, spec, 4, cfg, seed=0), spec, cfg, sim, 30):
         swapped |= sim.status[0, 3] == 1
     assert swapped and not (sim.status[0] == 2).any()
+
+
+def test_a_heuristic_built_for_another_map_refuses_the_state():
+    policy = strategies.get("CR", load_map("A"), 2, make_config("A"), seed=0)
+    sim = reset_state(load_map("C"), make_config("C"), [2], n_envs=1, seed=0)
+    with pytest.raises(ValueError, match="was built for map A"):
+        policy.predict(sim)

@@ -98,6 +98,10 @@ class HeuristicPolicy:
             actions (E, A, 2) int64 (message 0, move) and the memory to pass back.
         """
         sim = observation
+        if sim.idle.shape[1] != self.spec.n_vertices or sim.pos.shape[1] != self.cfg.max_agents:
+            raise ValueError(f"{type(self).__name__} was built for map {self.spec.name} ({self.spec.n_vertices} vertices, "
+                             f"{self.cfg.max_agents} slots); this state has {sim.idle.shape[1]} vertices and "
+                             f"{sim.pos.shape[1]} slots: build the heuristic with the env's map and config")
         memory = self._memory(sim, state, episode_start)
         mask = action_mask(self.spec, sim)                                     # (E, A, 5)
         active = sim.status == ACTIVE
