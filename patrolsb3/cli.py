@@ -41,11 +41,31 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+MINIMUMS = {"agents": 1, "episodes": 1, "tests": 1, "steps": 1, "repeats": 1, "last": 1, "timesteps": 1, "seed": 0,
+            "entry_seed": 0, "checkpoint_freq": 1, "eval_freq": 0, "cpus": 1, "cpus_per_trial": 1}
+"""The least value of every whole-number option of any command (by its argparse name): checked
+once here, for every command, before any work."""
+
+
+def check_minimums(args) -> None:
+    """Refuse a whole-number option below its minimum (:data:`MINIMUMS`) in one line naming it.
+
+    Raises:
+        ValueError: e.g. "--episodes must be a whole number >= 1, got 0".
+    """
+    for name, low in MINIMUMS.items():
+        value = getattr(args, name, None)
+        if isinstance(value, int) and not isinstance(value, bool) and value < low:
+            option = "--seed-of-entry" if name == "entry_seed" else "--" + name.replace("_", "-")
+            raise ValueError(f"{option} must be a whole number >= {low}, got {value}")
+
+
 def main(argv=None) -> int:
     """Entry point of the ``patrolsb3`` console script."""
     from .core.maps import MapError
     args = build_parser().parse_args(argv)
     try:
+        check_minimums(args)
         return int(args._module.run(args) or 0)
     except (MapError, ValueError, TypeError, FileNotFoundError) as exc:
         print(f"patrolsb3 {args.command}: error: {exc}", file=sys.stderr)

@@ -41,7 +41,7 @@ class ConfigError(ValueError):
     """A config.yml that cannot be read (not YAML, not a mapping)."""
 
 
-CONFIG_SCHEMA = {"map": str, "map_source": str, "map_shape": list, "variant": str, "algo": str, "seed": int,
+CONFIG_SCHEMA = {"map": str, "map_source": str, "map_text": str, "map_shape": list, "variant": str, "algo": str, "seed": int,
                  "timesteps": int, "env": dict, "hyperparams": dict, "versions": dict, "init_from": dict,
                  "env_version": str, "date": str, "source_model": str, "source_run": str, "budget": dict}
 """The keys a run's (or a zoo entry's) config.yml may hold, with their types: the train's own

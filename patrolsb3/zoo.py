@@ -31,7 +31,7 @@ import yaml
 
 from .core import protocol
 from .core.config import ENV_VERSION, EnvConfig, make_config
-from .core.maps import MapSpec, load_map
+from .core.maps import MapSpec, load_map, parse_map
 from .outputs import read_results
 from .runs import read_config, write_atomically, zip_is_intact  # noqa: F401  (zoo.read_config is public)
 
@@ -401,9 +401,14 @@ def load_checkpoint(path, spec=None) -> ZooPolicy:
                        f"{ENV_VERSION!r}; retrain it or use a matching patrolsb3 release")
     if not zip_is_intact(path):
         raise ZooError(f"{path}: the file is empty, cut or corrupt (its zip check fails)")
-    if spec is None:   # the training map file if it is still there, else the map by name
+    if spec is None:   # the training map file if it is still there, else its text, else the map by name
         source = config.get("map_source")
-        spec = source if source and Path(source).is_file() else config["map"]
+        if source and Path(source).is_file():
+            spec = source
+        elif config.get("map_text"):
+            spec = parse_map(config["map_text"], name=config["map"], source=str(source or "<config.yml>"))
+        else:
+            spec = config["map"]
     spec = checked_map(config, spec, path)
     import torch
     torch.set_num_threads(1)
@@ -484,9 +489,14 @@ def load_entry(folder, spec=None, device: str = "cpu") -> ZooPolicy:
     if version != ENV_VERSION:
         raise ZooError(f"{folder}: trained for env version {version!r}, this code is {ENV_VERSION!r}; "
                        f"retrain it or use a matching patrolsb3 release")
-    if spec is None:   # the training map file if it is still there, else the map by name
+    if spec is None:   # the training map file if it is still there, else its text, else the map by name
         source = config.get("map_source")
-        spec = source if source and Path(source).is_file() else config["map"]
+        if source and Path(source).is_file():
+            spec = source
+        elif config.get("map_text"):
+            spec = parse_map(config["map_text"], name=config["map"], source=str(source or "<config.yml>"))
+        else:
+            spec = config["map"]
     spec = checked_map(config, spec, folder)
     cfg = env_config(config)
     import torch

@@ -272,7 +272,7 @@ def test_resume_passes_over_empty_and_corrupt_checkpoints(tmp_path, capsys):
 def test_a_run_on_a_shipped_map_records_no_path_of_this_machine(tmp_path):
     run = train(map="A", timesteps=400, out=tmp_path, hyperparams=tiny_hp(n_envs=1), progress_bar=False)
     config = yaml.safe_load((run / "config.yml").read_text())
-    assert config["map_source"] == "maps/map_a.txt"
+    assert config["map_source"] == "maps/map_a.txt" and "map_text" not in config
 
 
 @pytest.mark.parametrize("setting, match", [

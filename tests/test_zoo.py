@@ -458,3 +458,23 @@ def test_the_export_command_refuses_an_existing_entry_and_never_leaves_old_figur
                      "--steps", "20"]) == 0
     assert not (entry / "listening.json").exists() and (entry / "eval.json").is_file()
     assert str(other) in yaml.safe_load((entry / "config.yml").read_text())["source_run"]
+
+
+def test_an_entry_of_a_map_file_that_moved_still_loads_from_its_config(tmp_path):
+    """config.yml records a map file by its resolved path and, for a map not shipped, its text:
+    an entry acts after the map file was moved or from another working directory."""
+    map_file = tmp_path / "maps" / "room.txt"
+    map_file.parent.mkdir()
+    map_file.write_text(ROOM_TEXT)
+    link = tmp_path / "room_link.txt"
+    link.symlink_to(map_file)
+    hp = {"n_steps": 16, "n_minibatches": 2, "n_envs": 2, "eval_freq": 0, "checkpoint_freq": 10**9,
+          "env": {"episode_steps": 20}, "policy_kwargs": {"dense_sizes": [16], "lstm_hidden_size": 8}}
+    run = train(map=str(link), variant="rl-msg", timesteps=320, run_dir=tmp_path / "run", hyperparams=hp,
+                progress_bar=False)
+    config = yaml.safe_load((run / "config.yml").read_text())
+    assert config["map_source"] == str(map_file.resolve()) and config["map_text"].startswith("S.....")
+    folder = zoo.export(run, zoo_dir=tmp_path / "zoo")
+    map_file.rename(tmp_path / "elsewhere.txt")
+    policy = zoo.load_entry(folder)
+    assert policy.spec.shape == (4, 6) and policy.spec.to_text() == config["map_text"]

@@ -14,10 +14,14 @@ def parse_agents(text: str) -> list[int]:
         for part in str(text).split(","):
             if "-" in part:
                 low, high = (int(v) for v in part.split("-"))
+                if low > high:
+                    raise ValueError(f"bad --agents {text!r}: the range {part} is reversed (write {high}-{low})")
                 sizes.update(range(low, high + 1))
             elif part.strip():
                 sizes.add(int(part))
-    except ValueError:
+    except ValueError as exc:
+        if "reversed" in str(exc):
+            raise
         raise ValueError(f"bad --agents {text!r}: expected sizes like 1-5 or 1,3,5") from None
     if not sizes or min(sizes) < 1:
         raise ValueError(f"bad --agents {text!r}: team sizes must be >= 1")
@@ -120,6 +124,8 @@ def run(args):
     if args.protocol == "paper":
         args.tests, args.episodes, args.steps = 10, 100, 14400
     maps = [m.strip() for m in args.maps.split(",") if m.strip()]
+    if duplicates := sorted({m for m in maps if maps.count(m) > 1}):
+        raise ValueError(f"--maps {args.maps}: {', '.join(duplicates)} given more than once")
     sizes = parse_agents(args.agents)
     try:
         zoo = importlib.import_module("patrolsb3.zoo")

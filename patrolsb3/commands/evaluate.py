@@ -29,8 +29,12 @@ def run(args):
     torch_device(args.device)   # a device torch cannot use: one line, before any work
     if args.json:
         check_output_file(args.json, "--json")
+    faults = parse_faults(args.faults)
+    if sum(k for _, k in faults) > args.agents:
+        raise ValueError(f"--faults {' '.join(args.faults)}: {sum(k for _, k in faults)} agents fail in a team of "
+                         f"{args.agents} (--agents)")
     result = evaluate(args.strategy, args.map, args.agents, episodes=args.episodes, tests=args.tests,
-                      steps=args.steps, seed=args.seed, faults=parse_faults(args.faults),
+                      steps=args.steps, seed=args.seed, faults=faults,
                       progress=not args.no_progress, deterministic=not args.stochastic, device=args.device)
     print(evaluation_text(result))
     if args.json:

@@ -297,11 +297,18 @@ def _all_pairs_bfs(free_cells, free_index, neighbour, move_ok):
 
 def source_label(spec: MapSpec) -> str:
     """Where a map came from, for config files and output: ``maps/map_<x>.txt`` for a shipped
-    map (no path of this machine), else the path it was loaded from."""
+    map (no path of this machine), else the file it was loaded from with every link and relative
+    part resolved (so that it still names the file from another working directory), or the
+    source as given when it is not a file (``<string>``)."""
     source = Path(str(spec.source))
     if source.is_file() and source.resolve().parent == MAPS_DIR.resolve():
         return f"maps/{source.name}"
-    return str(spec.source)
+    return str(source.resolve()) if source.is_file() else str(spec.source)
+
+
+def is_shipped(spec: MapSpec) -> bool:
+    """True for a map of the package's ``maps/`` folder."""
+    return source_label(spec).startswith("maps/")
 
 
 def available_maps() -> list[str]:

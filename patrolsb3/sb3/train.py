@@ -469,7 +469,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     """
     import torch
 
-    from ..core.maps import source_label
+    from ..core.maps import is_shipped, source_label
 
     device = torch_device(device)  # a device torch cannot use: one line, before any work
     shortcuts = {k: v for k, v in dict(n_envs=n_envs, eval_freq=eval_freq, checkpoint_freq=checkpoint_freq,
@@ -480,7 +480,8 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     torch.set_num_threads(int(hp.get("torch_threads", 1)))
     run = RunFolder(run_dir if run_dir is not None else
                     Path(out) / spec_map.name / variant / (run_id or f"{spec.name}_seed{seed}"))
-    config = {"map": spec_map.name, "map_source": source_label(spec_map), "map_shape": list(spec_map.shape),
+    config = {"map": spec_map.name, "map_source": source_label(spec_map),
+              **({} if is_shipped(spec_map) else {"map_text": spec_map.to_text()}), "map_shape": list(spec_map.shape),
               "variant": variant, "algo": spec.name, "seed": int(seed), "timesteps": total,
               "env": cfg.to_dict(), "hyperparams": hp, "versions": versions()}
     if resume and init_from is not None:
