@@ -57,6 +57,7 @@ def read_figures(results_csv) -> dict:
 
     Raises:
         FileNotFoundError: no results.csv there (names it).
+        ValueError: a results.csv that is cut, damaged or of another kind (names it).
     """
     path = Path(results_csv)
     if path.is_dir():
@@ -69,10 +70,21 @@ def read_figures(results_csv) -> dict:
             return float(text)
         except (TypeError, ValueError):
             return float("nan")
-    with path.open(newline="") as f:
-        return {(r["map"], int(r["n"]), r["strategy"], r["metric"]):
-                Figure(number(r["mean"]), number(r.get("ci95_low")), number(r.get("ci95_high")))
-                for r in csv.DictReader(f)}
+    needed = ("map", "n", "strategy", "metric", "mean")
+    try:
+        with path.open(newline="") as f:
+            reader = csv.DictReader(f)
+            if reader.fieldnames is None or not set(needed) <= set(reader.fieldnames):
+                raise ValueError(f"its columns are {reader.fieldnames}, not {list(needed)} ...")
+            figures = {(r["map"], int(r["n"]), r["strategy"], r["metric"]):
+                       Figure(number(r["mean"]), number(r.get("ci95_low")), number(r.get("ci95_high")))
+                       for r in reader}
+    except (ValueError, TypeError, UnicodeDecodeError, csv.Error) as exc:
+        raise ValueError(f"{path}: not a results.csv written by 'patrolsb3 compare', or cut or damaged ({exc}); "
+                         f"run the comparison again") from None
+    if not figures:
+        raise ValueError(f"{path}: holds no results; run the comparison again")
+    return figures
 
 
 def _cells(figures: dict, who: str, metric: str, maps=None, sizes=None) -> list[tuple[str, int]]:
@@ -171,8 +183,8 @@ def training_reward(curves: dict, fraction: float = 0.2) -> dict:
     figures = {}
     for m, by_variant in curves.items():
         for variant, path in by_variant.items():
-            with open(path, newline="") as f:
-                rewards = [float(r["reward"]) for r in csv.DictReader(f)]
+            from .runs import read_curve
+            rewards = list(read_curve(path).get("reward", []))
             if not rewards:
                 continue
             tail = rewards[-max(1, int(len(rewards) * fraction)):]

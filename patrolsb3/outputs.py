@@ -97,6 +97,42 @@ def _nan_for_null(value):
     return value
 
 
+def read_json(path, what: str = "JSON file"):
+    """The value of a JSON file, or one line naming the file and what is wrong with it.
+
+    Args:
+        path: the file.
+        what: what the file should be, for the message (e.g. "eval.json of a zoo entry").
+
+    Raises:
+        ValueError: the file is not valid JSON (cut, damaged, or another kind of file).
+    """
+    import json
+    path = Path(path)
+    try:
+        return json.loads(path.read_text())
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a text file; expected a {what}") from None
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path}: not valid JSON, cut or damaged at line {exc.lineno} column {exc.colno} "
+                         f"({exc.msg}); expected a {what}") from None
+
+
+def read_eval_file(path) -> dict:
+    """A zoo entry's eval.json (``write_zoo_eval``'s), its figures' nulls back to NaN.
+
+    Raises:
+        ValueError: not valid JSON, or not such a file (one line naming it).
+    """
+    data = read_json(path, "zoo entry's eval.json (patrolsb3 zoo eval)")
+    if not isinstance(data, dict) or not isinstance(data.get("results"), list) \
+            or not all(isinstance(r, dict) and "n_agents" in r and "summary" in r for r in data["results"]):
+        raise ValueError(f"{path}: not an eval.json written by 'patrolsb3 zoo eval' (no results per team size); "
+                         f"rewrite it with 'patrolsb3 zoo eval'")
+    data["results"] = read_results(data["results"])
+    return data
+
+
 def read_results(results: list) -> list:
     """Results read from JSON with their figures as written: a null inside a result's
     ``summary`` (a figure that did not exist) back to NaN."""

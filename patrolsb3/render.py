@@ -337,13 +337,9 @@ def plot_idleness_heatmap(spec: MapSpec, mean_idleness_per_vertex, path, title: 
 
 def read_curve(path) -> dict:
     """A learning-curve CSV of ``patrolsb3 train`` as columns of float arrays (one row per
-    finished parallel episode)."""
-    import csv
-    with open(path, newline="") as handle:
-        rows = list(csv.DictReader(handle))
-    if not rows:
-        return {}
-    return {key: np.array([float(r[key]) for r in rows]) for key in rows[0]}
+    finished parallel episode): :func:`patrolsb3.runs.read_curve`."""
+    from .runs import read_curve as read
+    return read(path)
 
 
 def trailing_mean(values: np.ndarray, window: int) -> np.ndarray:

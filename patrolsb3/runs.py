@@ -21,6 +21,7 @@ files back to it (:meth:`RunFolder.cut_back_to`). ``sb3/train.py``, ``sb3/cpu_ti
 """
 from __future__ import annotations
 
+import csv
 import json
 import re
 import shutil
@@ -150,6 +151,27 @@ def trim_rows(path, timesteps: int) -> int:
             writer.writerows(kept)
     write_atomically(path, write)
     return len(kept)
+
+
+def read_curve(path) -> dict:
+    """A run's curve.csv (or an entry's) as columns: {column: (N,) float array}, one row per
+    finished training episode; {} for a curve with its header only.
+
+    Raises:
+        ValueError: a file that is cut, damaged or not a curve (names it and the row).
+    """
+    import numpy as np
+    path = Path(path)
+    try:
+        with path.open(newline="") as handle:
+            reader = csv.DictReader(handle)
+            if reader.fieldnames is None or "timesteps" not in reader.fieldnames:
+                raise ValueError(f"no timesteps column (columns {reader.fieldnames})")
+            rows = list(reader)
+            columns = {key: np.array([float(r[key]) for r in rows]) for key in reader.fieldnames}
+    except (ValueError, TypeError, UnicodeDecodeError, csv.Error) as exc:
+        raise ValueError(f"{path}: not a curve.csv of 'patrolsb3 train', or cut or damaged ({exc})") from None
+    return columns if rows else {}
 
 
 def write_atomically(path, write) -> Path:

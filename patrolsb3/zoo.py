@@ -22,7 +22,6 @@ move phase (or one phase, as the model was trained), and carries the LSTM state.
 from __future__ import annotations
 
 import dataclasses
-import json
 import os
 from pathlib import Path
 
@@ -32,7 +31,7 @@ import yaml
 from .core import protocol
 from .core.config import ENV_VERSION, EnvConfig, make_config
 from .core.maps import MapSpec, load_map, parse_map
-from .outputs import read_results
+from .outputs import read_eval_file
 from .runs import read_config, write_atomically, zip_is_intact  # noqa: F401  (zoo.read_config is public)
 
 
@@ -179,16 +178,30 @@ def entry_dir(map_name: str, variant: str, zoo_dir=None, seed: int | None = None
     return folder if seed is None else folder / f"seed{int(seed)}"
 
 
-def read_entry(path: Path) -> dict:
-    """config.yml and eval.json of one entry folder, as one dict with its ``path``."""
+def read_entry(path: Path, damaged_eval_ok: bool = False) -> dict:
+    """config.yml and eval.json of one entry folder, as one dict with its ``path``.
+
+    Args:
+        path: the entry folder.
+        damaged_eval_ok: a damaged eval.json reads as none (``zoo eval`` rewrites it) instead of
+            an error.
+
+    Raises:
+        ZooError: no config.yml. ValueError: a damaged config.yml or eval.json (names it).
+    """
+    path = Path(path)
     config_file = path / "config.yml"
     if not config_file.is_file():
         raise ZooError(f"{path}: no config.yml; not a zoo entry")
     config = read_config(config_file)
     eval_file = path / "eval.json"
-    evaluation = json.loads(eval_file.read_text()) if eval_file.is_file() else None
-    if evaluation:
-        evaluation["results"] = read_results(evaluation.get("results", []))
+    evaluation = None
+    if eval_file.is_file():
+        try:
+            evaluation = read_eval_file(eval_file)
+        except ValueError:
+            if not damaged_eval_ok:
+                raise
     return {"path": str(path), "config": config, "eval": evaluation}
 
 
@@ -483,7 +496,7 @@ def load_entry(folder, spec=None, device: str = "cpu") -> ZooPolicy:
             or map size, or a file that cannot be loaded.
     """
     folder = Path(folder)
-    info = read_entry(folder)
+    info = read_entry(folder, damaged_eval_ok=True)      # acting needs no figures; zoo eval rewrites them
     config = info["config"]
     version = config.get("env_version")
     if version != ENV_VERSION:
@@ -624,8 +637,7 @@ def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
     path = entry_dir(map_name, variant, zoo_dir, seed=training_seed, guard=guard) / "eval.json"
     if not path.is_file():
         return None
-    data = json.loads(path.read_text())
-    data["results"] = read_results(data.get("results", []))
+    data = read_eval_file(path)
     if (data.get("episodes"), data.get("steps"), data.get("seed"), data.get("tests"),
             data.get("deterministic", True)) != (episodes, steps, seed, tests, deterministic):
         return None

@@ -4,10 +4,10 @@ evaluation, what its messages carry, usage), an index of them, and ``messages.md
 listening and ablation figures of every entry that has them, side by side."""
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from . import ablation
+from .outputs import read_json
 from .report import ZOO_TABLE_METRICS, mean_std
 
 VARIANT_TEXT = {"rl-msg": "learned 16-symbol messages (RIAL)", "rl-no-msg": "positions only, no messages",
@@ -55,7 +55,7 @@ def message_figures(entry: dict) -> tuple[dict | None, dict | None]:
     found = []
     for name in ("listening.json", "ablation.json"):
         path = folder / name
-        found.append(json.loads(path.read_text()) if path.is_file() else None)
+        found.append(read_json(path, f"{name} of 'patrolsb3 zoo {name.split('.')[0]}'") if path.is_file() else None)
     return found[0], found[1]
 
 

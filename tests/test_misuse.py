@@ -32,3 +32,48 @@ def test_a_value_that_makes_no_sense_is_refused_in_one_line(argv, message, tmp_p
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
     assert not any(tmp_path.iterdir())                   # nothing written
+
+
+def _damaged_entry(tmp_path):
+    """A zoo entry of a tiny trained run, then its eval.json cut in the middle."""
+    from patrolsb3 import zoo
+    from patrolsb3.sb3.train import train
+    (tmp_path / "room.txt").write_text("S.....\n......\n......\n")
+    hp = {"n_steps": 8, "n_minibatches": 1, "n_envs": 1, "eval_freq": 0, "checkpoint_freq": 10**9,
+          "env": {"episode_steps": 10}, "policy_kwargs": {"dense_sizes": [8], "lstm_hidden_size": 4}}
+    run = train(map=str(tmp_path / "room.txt"), timesteps=80, run_dir=tmp_path / "run", hyperparams=hp,
+                progress_bar=False)
+    entry = zoo.export(run, zoo_dir=tmp_path / "zoo")
+    from patrolsb3.evaluate import write_zoo_eval
+    text = write_zoo_eval(entry, episodes=1, steps=10, progress=False).read_text()
+    (entry / "eval.json").write_text(text[:len(text) // 2])
+    return entry
+
+
+def test_a_damaged_file_is_named_in_one_line_by_every_command_that_reads_it(tmp_path, capsys, monkeypatch):
+    entry = _damaged_entry(tmp_path)
+    monkeypatch.setenv("PATROLSB3_ZOO", str(tmp_path / "zoo"))
+    capsys.readouterr()
+    for argv in (["zoo", "list"], ["zoo", "show", "ROOM", "rl-msg"]):
+        assert cli.main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert f"{entry / 'eval.json'}: not valid JSON, cut or damaged" in err and len(err.splitlines()) == 1
+    # zoo eval rewrites it
+    assert cli.main(["zoo", "eval", "ROOM", "rl-msg", "--episodes", "1", "--steps", "10"]) == 0
+    assert cli.main(["zoo", "show", "ROOM", "rl-msg"]) == 0
+    # a results.csv, a curve.csv, a hyperparameter file
+    (tmp_path / "c").mkdir()
+    (tmp_path / "c" / "results.csv").write_text("map,n,strategy\nA,1")
+    assert cli.main(["claims", str(tmp_path / "c")]) == 2
+    assert "results.csv: not a results.csv written by 'patrolsb3 compare'" in capsys.readouterr().err
+    from patrolsb3.runs import read_curve
+    (tmp_path / "curve.csv").write_text("timesteps,reward\n10,1.5\n20,")
+    with pytest.raises(ValueError, match="curve.csv: not a curve.csv of 'patrolsb3 train', or cut or damaged"):
+        read_curve(tmp_path / "curve.csv")
+    (tmp_path / "hp.yml").write_text("default: {gamma: [0.9\n")
+    capsys.readouterr()
+    assert cli.main(["train", "--hyperparams", str(tmp_path / "hp.yml"), "--timesteps", "10",
+                     "--out", str(tmp_path / "runs")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "hp.yml: not valid YAML, cut or damaged" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "runs").exists()

@@ -30,12 +30,15 @@ def load_hyperparams(map_name: str, path: str | Path | None = None) -> dict:
 
     Raises:
         FileNotFoundError: the file does not exist.
-        ValueError: the file has no ``default:`` entry or is not a mapping.
+        ValueError: the file is not YAML, has no ``default:`` entry or is not a mapping.
     """
     path = Path(path) if path is not None else DEFAULT_FILE
     if not path.is_file():
         raise FileNotFoundError(f"hyperparameter file {path} not found")
-    table = yaml.safe_load(path.read_text()) or {}
+    try:
+        table = yaml.safe_load(path.read_text()) or {}
+    except (yaml.YAMLError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path}: not valid YAML, cut or damaged ({str(exc).splitlines()[0]})") from None
     if not isinstance(table, dict) or not isinstance(table.get("default"), dict):
         raise ValueError(f"{path}: expected a mapping with a 'default:' entry (keyed by map name)")
     return merge(table["default"], table.get(str(map_name)) or {})
