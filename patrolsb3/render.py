@@ -227,26 +227,28 @@ def show_frame(frame: np.ndarray, viewer=None):
 
 
 def save_gif(frames, path, fps: float = 10) -> Path:
-    """Write frames as a looping GIF animation.
+    """Write frames as a looping GIF animation, taking them one at a time: ``frames`` may be a
+    generator, so a long episode is never held as RGB arrays (Pillow keeps each frame as a
+    one-byte-per-pixel palette image until the file is written).
 
     Args:
-        frames: a non-empty sequence of (H_px, W_px, 3) uint8 arrays of one size.
+        frames: a non-empty iterable of (H_px, W_px, 3) uint8 arrays of one size.
         path: output file.
         fps: frames per second.
 
     Returns:
         The path written.
     """
-    frames = list(frames)
-    if not frames:
-        raise ValueError("save_gif needs at least one frame")
     if fps <= 0:
         raise ValueError(f"fps must be > 0, got {fps}")
+    images = (Image.fromarray(np.asarray(f, dtype=np.uint8)) for f in frames)
+    first = next(images, None)
+    if first is None:
+        raise ValueError("save_gif needs at least one frame")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    images = [Image.fromarray(np.asarray(f, dtype=np.uint8)) for f in frames]
-    images[0].save(path, save_all=True, append_images=images[1:], duration=int(round(1000 / fps)),
-                   loop=0, optimize=True, disposal=1)
+    first.save(path, save_all=True, append_images=images, duration=int(round(1000 / fps)),
+               loop=0, optimize=True, disposal=1)
     return path
 
 

@@ -77,3 +77,24 @@ def test_a_damaged_file_is_named_in_one_line_by_every_command_that_reads_it(tmp_
     err = capsys.readouterr().err.strip()
     assert "hp.yml: not valid YAML, cut or damaged" in err and len(err.splitlines()) == 1
     assert not (tmp_path / "runs").exists()
+
+
+def test_a_run_too_big_for_this_machine_is_refused_and_a_big_checkpoint_announced(tmp_path, capsys, monkeypatch):
+    from patrolsb3.sb3 import train as train_module
+    monkeypatch.setattr(train_module, "physical_memory", lambda: 24 * 2 ** 30)       # this machine's 24 GiB
+    assert cli.main(["train", "--map", "A", "--timesteps", "1000", "--out", str(tmp_path / "runs"),
+                     "--set", "env.max_agents=1000"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "the rollout buffer would need about" in err and "MiB, more than 80 %" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "runs").exists()
+    monkeypatch.setattr(train_module, "CHECKPOINT_WARN_BYTES", 2 ** 20)
+    estimate = train_module.memory_estimate({"n_steps": 8, "policy_kwargs": {}}, _layout(), 40, 2, 5000)
+    train_module.check_memory(estimate)
+    assert "note: each checkpoint of this run will be about 14 MiB (1,239,207 parameters" in capsys.readouterr().err
+
+
+def _layout():
+    from patrolsb3.sb3.vec_env import make_vec_env
+    env = make_vec_env("A", agents=[1] * 8, variant="rl-msg", seed=0)
+    env.close()
+    return env.layout

@@ -35,27 +35,38 @@ def run(args):
     cfg = make_config(spec.name, episode_steps=max(5000, args.steps))
     state = reset_state(spec, cfg, args.agents, n_envs=1, seed=args.seed)
     policy = load_policy(args.strategy, spec, args.agents, cfg, seed=args.seed)
-    frames = [render_frame(spec, cfg, state, tile=args.tile)]
-    memory, totals = None, {"collisions": 0, "swaps": 0, "failures": 0}
-    for t in range(1, args.steps + 1):
-        actions, memory = policy.predict(state, memory)                   # (1, A, 2)
-        info = step(spec, cfg, state, actions[..., 1], messages=actions[..., 0],
-                    compute_reward=False)
-        totals["collisions"] += int(info.collisions.sum())
-        totals["swaps"] += int(info.swap_started.sum())
-        totals["failures"] += int((info.battery_failed | info.fault_failed).sum())
-        if t % args.every == 0 or info.terminated[0]:
-            frames.append(render_frame(spec, cfg, state, tile=args.tile))
-        if info.terminated[0]:
-            print(f"every agent failed at step {t}; the animation stops there")
-            break
-    path = save_gif(frames, args.out, fps=args.fps)
-    print(f"wrote {path} ({len(frames)} frames, {Path(path).stat().st_size // 1024} kB): "
+    memory, totals = None, {"collisions": 0, "swaps": 0, "failures": 0, "frames": 0}
+    last = {}
+
+    def frames():                     # one frame at a time: a long episode is never held whole
+        nonlocal memory
+        yield render_frame(spec, cfg, state, tile=args.tile)
+        for t in range(1, args.steps + 1):
+            actions, memory = policy.predict(state, memory)                   # (1, A, 2)
+            info = step(spec, cfg, state, actions[..., 1], messages=actions[..., 0],
+                        compute_reward=False)
+            totals["collisions"] += int(info.collisions.sum())
+            totals["swaps"] += int(info.swap_started.sum())
+            totals["failures"] += int((info.battery_failed | info.fault_failed).sum())
+            if t % args.every == 0 or info.terminated[0]:
+                yield render_frame(spec, cfg, state, tile=args.tile)
+            if info.terminated[0]:
+                print(f"every agent failed at step {t}; the animation stops there")
+                break
+
+    def counted(stream):
+        for frame in stream:
+            totals["frames"] += 1
+            last["frame"] = frame
+            yield frame
+
+    path = save_gif(counted(frames()), args.out, fps=args.fps)
+    print(f"wrote {path} ({totals['frames']} frames, {Path(path).stat().st_size // 1024} kB): "
           f"map {spec.name}, {args.agents} agents, {args.strategy.upper()}, seed {args.seed}, "
           f"{int(state.t[0])} steps, mean idleness {state.idle[0].mean():.1f}, "
           f"{totals['collisions']} collisions, {totals['swaps']} swaps, {totals['failures']} failures")
     if args.frame:
         Path(args.frame).parent.mkdir(parents=True, exist_ok=True)
-        Image.fromarray(frames[-1]).save(args.frame, optimize=True)
+        Image.fromarray(last["frame"]).save(args.frame, optimize=True)
         print(f"wrote {args.frame}")
     return 0

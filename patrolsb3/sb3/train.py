@@ -589,6 +589,71 @@ def _run_teams(spec_map, variant: str, hp: dict):
     return cfg, teams, (teams[0] if hp.get("curriculum", True) else final_teams)
 
 
+CHECKPOINT_WARN_BYTES = 100 * 2 ** 20
+"""A checkpoint above this size (100 MiB) is announced on stderr before training starts."""
+
+
+def memory_estimate(hp: dict, layout, rows: int, phases_per_step: int, episode_steps: int) -> dict:
+    """Bytes a run will need, estimated before its model is built: ``rollout`` (the rollout
+    buffer: observations, masks, LSTM states and the per-row scalars of ``n_steps`` x rows) and
+    ``checkpoint`` (weights and Adam's two moments, and the last observations SB3 saves).
+
+    Args:
+        hp: the run's hyperparameters.
+        layout: the vec env's observation layout (grid shape, vector and critic sizes).
+        rows: vec-env rows (parallel episodes x max_agents).
+        phases_per_step, episode_steps: for ``n_steps: episode``.
+    """
+    n_steps = rollout_env_steps(hp["n_steps"], episode_steps, phases_per_step)
+    kwargs = hp.get("policy_kwargs") or {}
+    hidden = int(kwargs.get("lstm_hidden_size", 128))
+    dense = [int(v) for v in kwargs.get("dense_sizes", (512, 341, 227))]
+    channels = [int(v) for v in kwargs.get("conv_channels", (4, 8))]
+    C, H, W = layout.grid_shape
+    obs_dim = C * H * W + layout.vector_size + layout.critic_size
+    n_actions = 21
+    per_row = obs_dim + n_actions + 4 * hidden + 8                  # floats stored per row and env step
+    conv_out = channels[-1] * max(1, H - 4) * max(1, W - 4)
+    params = 0
+    for extra in (layout.vector_size, layout.vector_size + layout.critic_size):   # actor, critic
+        width = conv_out + extra
+        for size in dense:
+            params += width * size + size
+            width = size
+    params += 4 * hidden * (dense[-1] + hidden + 2) + (hidden + 1) * n_actions + dense[-1] + 1
+    return {"rollout": 4 * n_steps * rows * per_row,
+            "checkpoint": 4 * (3 * params + rows * (obs_dim + 4 * hidden)), "parameters": params}
+
+
+def physical_memory() -> int | None:
+    """This machine's memory in bytes (Linux and macOS), None where it cannot be read."""
+    import os
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def check_memory(estimate: dict, vec_env=None) -> None:
+    """Refuse a run whose rollout buffer would not fit in 80 % of this machine's memory; announce
+    a checkpoint above :data:`CHECKPOINT_WARN_BYTES` on stderr (sizes in MiB).
+
+    Raises:
+        ValueError: the rollout would not fit (one line with the sizes).
+    """
+    total = physical_memory()
+    if total and estimate["rollout"] > 0.8 * total:
+        if vec_env is not None:
+            vec_env.close()
+        raise ValueError(f"the rollout buffer would need about {estimate['rollout'] / 2 ** 20:,.0f} MiB, more than "
+                         f"80 % of this machine's {total / 2 ** 20:,.0f} MiB: fewer n_steps, parallel episodes "
+                         f"(n_envs) or env.max_agents")
+    if estimate["checkpoint"] > CHECKPOINT_WARN_BYTES:
+        print(f"note: each checkpoint of this run will be about {estimate['checkpoint'] / 2 ** 20:,.0f} MiB "
+              f"({estimate['parameters']:,} parameters, the optimizer state and the last observations)",
+              file=sys.stderr)
+
+
 def _build_model(spec_map, variant: str, spec, hp: dict, seed: int, start_teams, checkpoint, warm_weights,
                  config: dict, run: RunFolder, device: str, verbose: int):
     """The training vec env and the model: loaded from ``checkpoint``, or new (from
@@ -599,6 +664,8 @@ def _build_model(spec_map, variant: str, spec, hp: dict, seed: int, start_teams,
     vec_env = make_vec_env(spec_map, agents=start_teams, variant=variant, seed=seed, strict=spec.masked,
                            episode_env=mixed_episodes(hp, len(start_teams)), **env_kwargs)  # bad env: no run folder
     rows = vec_env.num_envs
+    check_memory(memory_estimate(hp, vec_env.layout, rows, vec_env.phases_per_step, config["env"]["episode_steps"]),
+                 vec_env)
     if hp.get("normalize_reward", False):
         vec_env = normalized_rewards(vec_env, checkpoint, per_phase(hp["gamma"], vec_env.phases_per_step))
     if checkpoint is not None:
