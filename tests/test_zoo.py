@@ -449,7 +449,12 @@ def test_the_export_command_refuses_an_existing_entry_and_never_leaves_old_figur
     assert cli.main(common + ["--overwrite", "--episodes", "1", "--steps", "20"]) != 0
     assert "interrupted" in capsys.readouterr().err
     assert (entry / "model.zip").read_bytes() == model and (entry / "listening.json").is_file()
-    assert sorted(p.name for p in entry.parent.iterdir()) == ["seed0"]           # no staging left
+    assert sorted(p.name for p in entry.parent.iterdir() if not p.name.endswith(".lock")) == ["seed0"]  # no staging left
+    # a second export of the same entry while one is running is refused
+    from filelock import FileLock
+    with FileLock(entry.with_name(".seed0.lock")):
+        assert cli.main(common + ["--overwrite", "--episodes", "1", "--steps", "20"]) == 2
+        assert "is being exported by another process" in capsys.readouterr().err
     monkeypatch.undo()
     # --overwrite replaces the entry whole: the old model's figures go with it
     other = tmp_path / "other_run"

@@ -236,22 +236,32 @@ def export_and_evaluate(args) -> int:
         raise ValueError(f"--cpu-hours must be a number >= 0, got {args.cpu_hours}")
     if args.checkpoint is not None and not os.path.isfile(args.checkpoint):
         raise ValueError(f"--checkpoint {args.checkpoint}: no such file")
+    from filelock import FileLock, Timeout
     entry = export_destination(args.run_dir, zoo_dir=args.zoo_dir, as_seed=args.as_seed)
-    if (entry / "model.zip").exists() and not args.overwrite:
-        raise ZooError(f"{entry} is an entry already; pass --overwrite to replace it (its model and every "
-                       f"figure of it), or export with another --zoo-dir")
-    staged = entry.with_name(f".{entry.name}.export-{os.getpid()}")
-    budget = {"cpu_hours": args.cpu_hours} if args.cpu_hours is not None else {}
+    entry.parent.mkdir(parents=True, exist_ok=True)
+    lock = FileLock(entry.with_name(f".{entry.name}.lock"))
     try:
-        export(args.run_dir, zoo_dir=args.zoo_dir, budget=budget, checkpoint=args.checkpoint,
-               as_seed=args.as_seed, into=staged)
-        if not args.no_eval:
-            write_zoo_eval(staged, episodes=args.episodes, steps=args.steps, seed=args.seed,
-                           deterministic=not args.stochastic)
-        replace_entry(staged, entry)
+        lock.acquire(timeout=0)
+    except Timeout:
+        raise ZooError(f"{entry} is being exported by another process; wait for it to end") from None
+    try:
+        if (entry / "model.zip").exists() and not args.overwrite:
+            raise ZooError(f"{entry} is an entry already; pass --overwrite to replace it (its model and every "
+                           f"figure of it), or export with another --zoo-dir")
+        staged = entry.with_name(f".{entry.name}.export-{os.getpid()}")
+        budget = {"cpu_hours": args.cpu_hours} if args.cpu_hours is not None else {}
+        try:
+            export(args.run_dir, zoo_dir=args.zoo_dir, budget=budget, checkpoint=args.checkpoint,
+                   as_seed=args.as_seed, into=staged)
+            if not args.no_eval:
+                write_zoo_eval(staged, episodes=args.episodes, steps=args.steps, seed=args.seed,
+                               deterministic=not args.stochastic)
+            replace_entry(staged, entry)
+        finally:
+            if staged.exists():
+                shutil.rmtree(staged)
     finally:
-        if staged.exists():
-            shutil.rmtree(staged)
+        lock.release()
     print(f"exported to {entry}")
     if not args.no_eval:
         print(f"evaluation written to {entry / 'eval.json'}")
