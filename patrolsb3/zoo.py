@@ -45,6 +45,19 @@ ZOO_ENV = "PATROLSB3_ZOO"
 """Environment variable naming a zoo folder (e.g. a clone's ``zoo/``) for an installed package."""
 
 
+def use_zoo_dir(zoo_dir) -> None:
+    """Make ``zoo_dir`` the zoo of this process and the processes it starts (Ray's included):
+    what a command's ``--zoo-dir`` does, through ``$PATROLSB3_ZOO``.
+
+    Raises:
+        ZooError: not a folder.
+    """
+    root = Path(zoo_dir)
+    if not root.is_dir():
+        raise ZooError(f"--zoo-dir {root}: not a folder; give the zoo/ folder of a patrolsb3 clone")
+    os.environ[ZOO_ENV] = str(root.resolve())
+
+
 def zoo_root(zoo_dir=None) -> Path:
     """Where the zoo is: ``zoo_dir`` if given, else ``$PATROLSB3_ZOO``, else the checkout's ``zoo/``.
 
@@ -64,7 +77,7 @@ def zoo_root(zoo_dir=None) -> Path:
         return ZOO_DIR
     raise ZooError(f"no zoo found (looked for ${ZOO_ENV} and {ZOO_DIR.name}/ beside the package): the zoo "
                    f"ships with the git repository, not the wheel; clone it and set {ZOO_ENV} to its zoo/ "
-                   f"folder, or pass zoo_dir=")
+                   f"folder, or give the zoo folder with --zoo-dir (commands) or zoo_dir= (Python)")
 
 
 VARIANT_NAMES = ("rl-msg", "rl-no-msg", "rl-intention")

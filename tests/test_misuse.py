@@ -98,3 +98,17 @@ def _layout():
     env = make_vec_env("A", agents=[1] * 8, variant="rl-msg", seed=0)
     env.close()
     return env.layout
+
+
+def test_evaluate_and_compare_take_a_zoo_dir(tmp_path, capsys, monkeypatch):
+    import os
+
+    from patrolsb3.zoo import ZOO_ENV
+    monkeypatch.setenv(ZOO_ENV, "")                      # restored after the test
+    assert cli.main(["evaluate", "--strategy", "zoo:rl-msg", "--zoo-dir", str(tmp_path / "none")]) == 2
+    assert "--zoo-dir" in capsys.readouterr().err and os.environ[ZOO_ENV] == ""
+    (tmp_path / "zoo").mkdir()
+    assert cli.main(["evaluate", "--strategy", "zoo:rl-msg", "--map", "A", "--episodes", "1", "--steps", "5",
+                     "--zoo-dir", str(tmp_path / "zoo"), "--no-progress"]) == 2     # an empty zoo: no entry
+    assert os.environ[ZOO_ENV] == str((tmp_path / "zoo").resolve())
+    assert "zoo" in capsys.readouterr().err

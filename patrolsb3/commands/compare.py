@@ -85,13 +85,16 @@ def add_arguments(parser):
                              "zoo models available for each map)")
     parser.add_argument("--protocol", choices=["paper"], default=None,
                         help="'paper': 10 tests x 100 episodes x 14,400 steps")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=int, default=0,
+                        help="simulator seed of the episodes (default 0, the seed of the zoo's eval.json)")
     parser.add_argument("--out", required=True, help="output folder")
-    parser.add_argument("--no-progress", action="store_true")
+    parser.add_argument("--zoo-dir", default=None,
+                        help="the zoo to read (default: $PATROLSB3_ZOO, else the checkout's zoo/)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bars, one line per cell")
     parser.add_argument("--stochastic", action="store_true",
                         help="zoo models sample their actions (default: the most likely legal action)")
     parser.add_argument("--rerun", action="store_true",
-                        help="evaluate the heuristics again even when OUT/results.json already holds "
+                        help="evaluate the heuristics (only them; see --rerun-zoo) again even when OUT/results.json already holds "
                              "a result of this exact protocol (a rerun or an interrupted run reuses them)")
     parser.add_argument("--device", default="cpu", choices=["auto", "cpu", "cuda"],
                         help="where zoo models' networks run (default cpu; auto = cuda when torch sees one)")
@@ -117,6 +120,9 @@ def run(args):
     from ..result_store import ResultStore
     from ..sb3.algorithms import torch_device
     torch_device(args.device)   # a device torch cannot use: one line, before any work
+    if args.zoo_dir:
+        from ..zoo import use_zoo_dir
+        use_zoo_dir(args.zoo_dir)
     from ..outputs import check_output_dir
     check_output_dir(args.out, "--out")
     from ..claims import read_faults_result

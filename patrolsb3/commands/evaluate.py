@@ -10,7 +10,9 @@ def add_arguments(parser):
     parser.add_argument("--episodes", type=int, default=100, help="episodes per test (default 100)")
     parser.add_argument("--steps", type=int, default=14400, help="steps per episode (default 14400 = 24 h)")
     parser.add_argument("--tests", type=int, default=1, help="tests; mean +- std over them (default 1)")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=int, default=0, help="simulator seed of the episodes (default 0)")
+    parser.add_argument("--zoo-dir", default=None,
+                        help="the zoo of a zoo: strategy (default: $PATROLSB3_ZOO, else the checkout's zoo/)")
     parser.add_argument("--faults", action="append", default=[], metavar="STEP:K",
                         help="K agents fail for good at STEP (repeatable); AVG/MAX are split at each")
     parser.add_argument("--stochastic", action="store_true",
@@ -27,6 +29,9 @@ def run(args):
     from ..outputs import check_output_file, write_json
     from ..sb3.algorithms import torch_device
     torch_device(args.device)   # a device torch cannot use: one line, before any work
+    if args.zoo_dir:
+        from ..zoo import use_zoo_dir
+        use_zoo_dir(args.zoo_dir)
     if args.json:
         check_output_file(args.json, "--json")
     faults = parse_faults(args.faults)

@@ -9,7 +9,8 @@ def add_arguments(parser):
     parser.add_argument("--out", default="runs/", help="root of run folders (default runs/)")
     parser.add_argument("--algo", default=None,
                         help="MaskableRecurrentPPO (default) | MaskablePPO | RecurrentPPO")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=int, default=0,
+                        help="seed of the environments and the networks' initial weights (default 0)")
     parser.add_argument("--run-id", default=None, help="run folder name (default <algo>_seed<seed>)")
     parser.add_argument("--resume", action="store_true", help="continue the run folder from its newest checkpoint")
     parser.add_argument("--init-from", default=None, metavar="MODEL",
@@ -30,7 +31,8 @@ def add_arguments(parser):
                         help="what the networks compute in while training (default: the hyperparameters' "
                              "precision): bf16 mixed precision where the CPU has it (docs/training.md)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
-    parser.add_argument("--verbose", type=int, default=0)
+    parser.add_argument("--verbose", type=int, default=0,
+                        help="SB3's verbosity: 0 quiet (default), 1 the training statistics of every update")
 
 
 def run(args):

@@ -10,11 +10,17 @@ import json
 import math
 
 
+def add_action(sub, name: str, help: str):
+    """A zoo action whose --help shows its own description (argparse shows ``help`` only in the
+    list of actions)."""
+    return sub.add_parser(name, help=help, description=help)
+
+
 def add_arguments(parser):
     sub = parser.add_subparsers(dest="zoo_command", required=True, metavar="ACTION")
-    p_list = sub.add_parser("list", help="list every zoo entry")
+    p_list = add_action(sub, "list", help="list every zoo entry")
     p_list.add_argument("--zoo-dir", default=None, help="another zoo folder")
-    p_show = sub.add_parser("show", help="print one entry's config and evaluation")
+    p_show = add_action(sub, "show", help="print one entry's config and evaluation")
     p_show.add_argument("map")
     p_show.add_argument("variant")
     p_show.add_argument("--zoo-dir", default=None)
@@ -22,7 +28,7 @@ def add_arguments(parser):
                        help="the entry behind the return guard (zoo/guarded/), not the paper's setting")
     p_show.add_argument("--seed-of-entry", type=int, default=None, dest="entry_seed",
                        help="one training seed's model (default: the entry's default seed)")
-    p_export = sub.add_parser("export", help="copy a training run into the zoo (policy only) and "
+    p_export = add_action(sub, "export", help="copy a training run into the zoo (policy only) and "
                                              "evaluate it for 1..max_agents agents into eval.json")
     p_export.add_argument("run_dir", help="run folder of 'patrolsb3 train'")
     p_export.add_argument("--zoo-dir", default=None)
@@ -41,7 +47,7 @@ def add_arguments(parser):
                                "ablation); without it an existing entry is refused")
     p_export.add_argument("--as-seed", action="store_true",
                           help="export into the entry's seed<k> subfolder (k: the run's seed), not its default")
-    p_val = sub.add_parser("validate", help="evaluate every checkpoint of a run on a short greedy protocol "
+    p_val = add_action(sub, "validate", help="evaluate every checkpoint of a run on a short greedy protocol "
                                             "(its own seed) and rank them: fewest battery failures, then AVG^h")
     p_val.add_argument("run_dir", help="run folder of 'patrolsb3 train'")
     p_val.add_argument("--agents", default="1,3,5", help="team sizes (default 1,3,5)")
@@ -49,7 +55,7 @@ def add_arguments(parser):
     p_val.add_argument("--steps", type=int, default=3000, help="steps per episode (default 3000 = 5 h)")
     p_val.add_argument("--seed", type=int, default=7, help="simulator seed (default 7; the zoo's eval uses 0)")
     p_val.add_argument("--last", type=int, default=None, help="only the newest N checkpoints")
-    p_eval = sub.add_parser("eval", help="evaluate an entry again and rewrite its eval.json (1..max_agents "
+    p_eval = add_action(sub, "eval", help="evaluate an entry again and rewrite its eval.json (1..max_agents "
                                           "agents, with 95 %% intervals over episodes)")
     p_eval.add_argument("map")
     p_eval.add_argument("variant")
@@ -62,7 +68,7 @@ def add_arguments(parser):
     p_eval.add_argument("--steps", type=int, default=14400, help="steps per episode (default 14400)")
     p_eval.add_argument("--seed", type=int, default=0)
     p_eval.add_argument("--stochastic", action="store_true", help="sampled actions instead of greedy")
-    p_choose = sub.add_parser("choose", help="pick the paper-setting entry's default seed by the greedy "
+    p_choose = add_action(sub, "choose", help="pick the paper-setting entry's default seed by the greedy "
                                              "validation of 'zoo validate' and write its default.yml")
     p_choose.add_argument("map")
     p_choose.add_argument("variant")
@@ -71,10 +77,10 @@ def add_arguments(parser):
     p_choose.add_argument("--episodes", type=int, default=4, help="episodes per team size (default 4)")
     p_choose.add_argument("--steps", type=int, default=3000, help="steps per episode (default 3000)")
     p_choose.add_argument("--seed", type=int, default=7, help="simulator seed (default 7; the zoo's eval uses 0)")
-    p_cards = sub.add_parser("cards", help="write one model card (markdown) per entry and an index")
+    p_cards = add_action(sub, "cards", help="write one model card (markdown) per entry and an index")
     p_cards.add_argument("--out", default="docs/zoo", help="folder of the cards (default docs/zoo)")
     p_cards.add_argument("--zoo-dir", default=None)
-    p_lis = sub.add_parser("listening", help="how much an entry's moves depend on the symbols it receives "
+    p_lis = add_action(sub, "listening", help="how much an entry's moves depend on the symbols it receives "
                                              "(KL and greedy change when they are randomised) and how it "
                                              "uses its alphabet")
     p_lis.add_argument("map")
@@ -88,7 +94,7 @@ def add_arguments(parser):
     p_lis.add_argument("--episodes", type=int, default=8, help="parallel episodes (default 8)")
     p_lis.add_argument("--steps", type=int, default=500, help="simulator steps (default 500)")
     p_lis.add_argument("--seed", type=int, default=1000, help="seed (default 1000; the zoo's eval uses 0)")
-    p_abl = sub.add_parser("ablation", help="the entry's AVG^h, MAX^h and collisions when the messages it "
+    p_abl = add_action(sub, "ablation", help="the entry's AVG^h, MAX^h and collisions when the messages it "
                                             "receives are made constant or shuffled between agents")
     p_abl.add_argument("map")
     p_abl.add_argument("variant", help="rl-msg or rl-intention")
