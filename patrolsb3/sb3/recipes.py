@@ -79,7 +79,7 @@ STAGE1_SHARE = 0.2
 
 def train_in_stages(map="A", variant: str = "rl-msg", timesteps: int = 10_000_000, seed: int = 0,
                     out="runs/", run_id: str | None = None, resume: bool = False,
-                    overrides: dict | None = None, **train_kwargs: Any) -> Path:
+                    overrides: dict | None = None, say=None, **train_kwargs: Any) -> Path:
     """The zoo's recipe in one call: ``zoo-stage1`` for a fifth of ``timesteps``, then
     ``zoo-stage2`` from its weights for the rest.
 
@@ -90,6 +90,7 @@ def train_in_stages(map="A", variant: str = "rl-msg", timesteps: int = 10_000_00
     Args:
         timesteps: agent-steps of both stages together.
         overrides: hyperparameters applied on top of each stage's recipe (``--set``).
+        say: receives a line naming each stage before it starts (default: stderr).
         **train_kwargs (Any): passed to :func:`patrolsb3.sb3.train.train` (progress_bar, device ...).
 
     Returns:
@@ -98,6 +99,8 @@ def train_in_stages(map="A", variant: str = "rl-msg", timesteps: int = 10_000_00
     from .hyperparams import merge
     from ..runs import RunFolder, model_steps
     from .train import train
+    import sys
+    say = say or (lambda line: print(line, file=sys.stderr, flush=True))
     run_id = run_id or f"seed{seed}"
     first = max(1, round(int(timesteps) * STAGE1_SHARE))
     stages = []
@@ -112,8 +115,11 @@ def train_in_stages(map="A", variant: str = "rl-msg", timesteps: int = 10_000_00
     model1 = RunFolder(run1).model_file
     stage1_done = model1.is_file() and (model_steps(model1) or 0) >= first
     if not stage1_done:
+        say(f"stage 1 of 2 (zoo-stage1: the patrol, full batteries): {first:,} agent-steps into {run1}")
         train(map=map, variant=variant, timesteps=first, seed=seed, out=out1, run_id=run_id,
               resume=resume and run1.exists(), hyperparams=hp1, **train_kwargs)
     resume2 = resume and run2.exists()
+    say(f"stage 2 of 2 (zoo-stage2: the recharge, from stage 1's weights): up to {int(timesteps):,} agent-steps "
+        f"into {run2}")
     return train(map=map, variant=variant, timesteps=int(timesteps), seed=seed, out=out2, run_id=run_id,
                  resume=resume2, init_from=None if resume2 else run1, hyperparams=hp2, **train_kwargs)

@@ -525,6 +525,7 @@ def _train_in_folder(run: RunFolder, model, vec_env, checkpoint, resume: bool, c
     callbacks, curve, cpu_time = _callbacks(spec_map, variant, spec, hp, seed, teams, total, run, model,
                                             vec_env, resumed=checkpoint is not None)
     remaining = total - model.num_timesteps
+    started_at = model.num_timesteps
     if remaining <= 0 and checkpoint is not None:
         print(f"--resume: {run.path} is already at {model.num_timesteps:,} agent-steps, at or past the "
               f"{total:,} asked for; nothing to train (raise --timesteps to train further)", file=sys.stderr)
@@ -536,7 +537,7 @@ def _train_in_folder(run: RunFolder, model, vec_env, checkpoint, resume: bool, c
         _save_final(model, vec_env, run, cpu_time)
     save_atomically(model, run.model_file)
     if curve.rows_written == 0 and remaining > 0:
-        print(f"curve.csv: no episode finished in these {remaining:,} agent-steps (episodes last "
+        print(f"curve.csv: no episode finished in these {model.num_timesteps - started_at:,} agent-steps (episodes last "
               f"{cfg.episode_steps:,} simulator steps); it holds its header only", file=sys.stderr)
     return run.path
 
