@@ -109,6 +109,9 @@ def train_in_stages(map="A", variant: str = "rl-msg", timesteps: int = 10_000_00
         hp = merge(recipe(f"zoo-stage{stage}"), overrides or {})
         stages.append((folder, hp))
     (out1, hp1), (out2, hp2) = stages
+    from .train import resolve_settings
+    for hp, steps in ((hp1, first), (hp2, int(timesteps))):     # both stages' settings, before any work
+        resolve_settings(map, variant, merge(hp, {"timesteps": steps}))
     from ..core.maps import load_map
     name = load_map(map).name
     run1, run2 = out1 / name / variant / run_id, out2 / name / variant / run_id
