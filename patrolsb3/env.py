@@ -103,6 +103,19 @@ class PatrolParallelEnv(ParallelEnv):
         self._act_space = spaces.MultiDiscrete([self.cfg.n_symbols, 5])
         self._viewer = None
 
+    def __str__(self) -> str:
+        """What the env is, in one line (PettingZoo's default prints only its name)."""
+        H, W = self.spec_map.shape
+        messages = {"learned": "learned 16-symbol messages", "intention": "intention messages",
+                    "none": "no messages"}.get(self.cfg.comm, self.cfg.comm)
+        if self.cfg.comm == "learned" and self.cfg.n_symbols != 16:
+            messages = f"learned {self.cfg.n_symbols}-symbol messages"
+        return (f"{self.metadata.get('name', 'patrol')}: map {self.spec_map.name} ({H} x {W}, "
+                f"{self.spec_map.n_vertices} vertices), {self.n_agents} agents of up to {self.cfg.max_agents}, "
+                f"{messages} ({self.cfg.message_timing}), {self.cfg.episode_steps:,}-step episodes")
+
+    __repr__ = __str__
+
     def reconfigure(self, **overrides) -> None:
         """Change EnvConfig fields that leave the spaces as they are (``episode_steps``,
         ``init_battery``, rewards, wind ...), effective from the next reset; a training run

@@ -19,7 +19,7 @@ def map_summary(spec) -> dict:
 def run(args):
     from pathlib import Path
 
-    from ..core.maps import available_maps, load_map, source_label
+    from ..core.maps import available_maps, load_map
     from ..outputs import check_output_dir
     if args.png:
         check_output_dir(args.png, "--png")
@@ -33,7 +33,7 @@ def run(args):
         print("  ".join(str(r[c]).ljust(widths[c]) for c in columns))
     if not args.no_draw:
         for spec in specs:
-            print(f"\nmap {spec.name} ({source_label(spec)})")
+            print(f"\nmap {spec.name} ({spec.source})")        # the file that exists here, shipped or not
             print(spec.to_text())
         print("\nlegend: # obstacle, . vertex, 1-9 priority vertex (idleness rate 1+p), S station")
     if args.png:

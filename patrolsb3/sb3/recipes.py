@@ -90,7 +90,7 @@ def train_in_stages(map="A", variant: str = "rl-msg", timesteps: int = 10_000_00
     Args:
         timesteps: agent-steps of both stages together.
         overrides: hyperparameters applied on top of each stage's recipe (``--set``).
-        say: receives a line naming each stage before it starts (default: stderr).
+        say (Callable[[str], None] | None): receives a line naming each stage before it starts (default: stderr).
         **train_kwargs (Any): passed to :func:`patrolsb3.sb3.train.train` (progress_bar, device ...).
 
     Returns:
