@@ -352,3 +352,12 @@ def test_a_run_folder_is_written_by_one_process_at_a_time(tmp_path, capsys):
     assert (run / "curve.csv").read_text() == curve       # nothing written while it was held
     train(map=ROOM, timesteps=800, run_dir=run, hyperparams=tiny_hp(), resume=True, progress_bar=False)
     assert RunFolder(run).has_files() and not RunFolder(tmp_path / "empty").has_files()
+
+
+def test_init_from_is_recorded_relative_to_the_working_directory(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    source = train(map=ROOM, timesteps=400, out="runs", hyperparams=tiny_hp(), progress_bar=False)
+    run = train(map=ROOM, timesteps=400, out="runs", run_id="warm", init_from=(tmp_path / source).resolve(),
+                progress_bar=False, hyperparams=tiny_hp())
+    recorded = yaml.safe_load((tmp_path / run / "config.yml").read_text())["init_from"]["path"]
+    assert recorded == str(source / "model.zip") and not recorded.startswith("/")

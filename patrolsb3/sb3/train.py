@@ -392,7 +392,7 @@ def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]
     if is_valid_model_file(path):   # a whole model (checkpoint or run's model.zip), not a policy only
         try:
             model = algo_class.load(str(path), device="cpu")
-            return model.policy.state_dict(), {"path": str(path),
+            return model.policy.state_dict(), {"path": recorded_path(path),
                                                "timesteps": int(model.num_timesteps) + earlier_stages(path),
                                                "cpu_hours": cpu_hours_of(path)}
         except Exception as exc:  # noqa: BLE001 - try the policy-only layout next
@@ -402,7 +402,18 @@ def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]
     except Exception as exc:  # noqa: BLE001
         errors.append(f"as a {policy_class.__name__}: {type(exc).__name__}: {exc}")
         raise ValueError(f"--init-from: {path} cannot be loaded ({'; '.join(errors)})") from exc
-    return policy.state_dict(), {"path": str(path), **policy_budget(RunFolder(path.parent))}
+    return policy.state_dict(), {"path": recorded_path(path), **policy_budget(RunFolder(path.parent))}
+
+
+def recorded_path(path) -> str:
+    """How config.yml records a file: relative to the working directory when it lies under it
+    (a run started from the repository root names its source as ``runs/...``, no path of this
+    machine), else resolved and absolute."""
+    path = Path(path)
+    try:
+        return str(path.resolve().relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(path.resolve())
 
 
 def policy_budget(folder: RunFolder) -> dict:
