@@ -361,3 +361,12 @@ def test_init_from_is_recorded_relative_to_the_working_directory(tmp_path, monke
                 progress_bar=False, hyperparams=tiny_hp())
     recorded = yaml.safe_load((tmp_path / run / "config.yml").read_text())["init_from"]["path"]
     assert recorded == str(source / "model.zip") and not recorded.startswith("/")
+
+
+def test_config_records_the_env_the_run_trained_in(tmp_path):
+    """RecurrentPPO has no masks: its env acts a masked move as Stay, and config.yml says so."""
+    run = train(map=ROOM, timesteps=400, out=tmp_path, algo="RecurrentPPO", hyperparams=tiny_hp(),
+                progress_bar=False)
+    assert RunFolder(run).read_config()["env"]["invalid_action"] == "stay"
+    masked = train(map=ROOM, timesteps=400, out=tmp_path, run_id="masked", hyperparams=tiny_hp(), progress_bar=False)
+    assert RunFolder(masked).read_config()["env"]["invalid_action"] == "raise"

@@ -582,18 +582,17 @@ def resolve_settings(map, variant: str, hyperparams: dict | None = None, hyperpa
     hp = resolve_hyperparams(spec_map.name, hyperparams_file, hyperparams or {})
     spec = get_algorithm(hp.get("algo", DEFAULT_ALGORITHM))
     check_run_settings(hp, hp.get("timesteps"))
-    cfg, teams, start_teams = _run_teams(spec_map, variant, hp)
+    cfg, teams, start_teams = _run_teams(spec_map, variant, hp, strict=spec.masked)
     for episode_env in mixed_episodes(hp, len(start_teams)).values():     # each mixed setting is valid too
         make_config(spec_map.name, **{**variant_overrides(variant), **dict(hp.get("env") or {}), **episode_env})
     return Settings(spec_map, hp, spec, int(hp["timesteps"]), cfg, teams, start_teams)
 
 
-def _run_teams(spec_map, variant: str, hp: dict):
-    """The run's env config, its curriculum of team sizes and the teams it starts with."""
-    from ..core.config import make_config
-    from .variants import variant_overrides
-    from .vec_env import DEFAULT_AGENTS
-    cfg = make_config(spec_map.name, **variant_overrides(variant), **dict(hp.get("env") or {}))
+def _run_teams(spec_map, variant: str, hp: dict, strict: bool = True):
+    """The run's env config (the one its vec env runs: :func:`patrolsb3.sb3.vec_env.training_config`),
+    its curriculum of team sizes and the teams it starts with."""
+    from .vec_env import DEFAULT_AGENTS, training_config
+    cfg = training_config(spec_map, variant, strict, **dict(hp.get("env") or {}))
     n_par = int(hp.get("n_envs", 8))
     teams = curriculum_teams(n_par, min(cfg.max_agents, spec_map.n_vertices))
     final_teams = [min(k, cfg.max_agents, spec_map.n_vertices) for k in

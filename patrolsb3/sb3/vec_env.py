@@ -209,6 +209,19 @@ class PatrolVecEnv(VecEnvWrapper):
         return [False for _ in self._get_indices(indices)]
 
 
+def training_config(map, variant: str, strict: bool = True, **env_kwargs):
+    """The EnvConfig a training vec env runs (:func:`make_vec_env` builds its episodes from it,
+    ``train`` records it in config.yml): the map's paper values, the variant's messages, the
+    given settings, and ``invalid_action`` "raise" (``strict``, masked algorithms) or "stay".
+
+    Raises:
+        TypeError, ValueError: as :func:`make_vec_env`.
+    """
+    spec = load_map(map)
+    config = {**variant_overrides(variant), **env_kwargs, "invalid_action": "raise" if strict else "stay"}
+    return make_config(spec.name, **config)
+
+
 def make_vec_env(map="A", agents: Sequence[int] = DEFAULT_AGENTS, variant: str = "rl-msg",
                  seed: int | None = 0, strict: bool = True, episode_env: dict | None = None,
                  **env_kwargs) -> PatrolVecEnv:
@@ -243,8 +256,7 @@ def make_vec_env(map="A", agents: Sequence[int] = DEFAULT_AGENTS, variant: str =
     if not agents:
         raise ValueError("agents must list at least one team size (one per parallel episode)")
     spec = load_map(map)
-    config = {**variant_overrides(variant), **env_kwargs, "invalid_action": "raise" if strict else "stay"}
-    base = make_config(spec.name, **config)
+    base = training_config(spec, variant, strict, **env_kwargs)
     configs = [base] * len(agents)
     for i, overrides in (episode_env or {}).items():
         if not 0 <= int(i) < len(agents):
