@@ -25,6 +25,7 @@ from .core.maps import load_map
 from .core.metrics import EpisodeMetrics, idleness_lower_bounds
 from .core.state import reset_state
 from .core.step import step
+from .stats import interval
 
 CLEAN_METRICS = ("avg_idleness", "max_idleness", "worst_idleness", "std_idleness", "collisions")
 """Averaged over episodes without a battery failure."""
@@ -126,19 +127,10 @@ def run_episodes(policy, spec, cfg, n_agents: int, n_envs: int, seed: int = 0, p
 
 
 def interval95(values, resamples: int = 2000) -> list:
-    """95 % interval of the mean of ``values`` (per-episode figures): scipy's percentile bootstrap
-    (seeded, so a table is reproducible); [mean, mean] for fewer than 2 finite values or no
-    spread, [nan, nan] for none."""
-    values = np.asarray(values, dtype=np.float64)
-    values = values[np.isfinite(values)]
-    if len(values) == 0:
-        return [float("nan"), float("nan")]
-    if len(values) < 2 or values.min() == values.max():
-        return [float(values.mean()), float(values.mean())]
-    from scipy.stats import bootstrap
-    ci = bootstrap((values,), np.mean, confidence_level=0.95, n_resamples=resamples, method="percentile",
-                   random_state=0).confidence_interval
-    return [float(ci.low), float(ci.high)]
+    """95 % bootstrap interval of the mean of per-episode ``values``
+    (:func:`patrolsb3.stats.mean_interval`)."""
+    from .stats import mean_interval
+    return mean_interval(values, resamples)
 
 
 def summarize(per_episode: dict, tests: int) -> dict:
@@ -150,8 +142,9 @@ def summarize(per_episode: dict, tests: int) -> dict:
 
     Returns:
         dict metric -> {"mean", "std", "tests": [per-test values], "ci95": [low, high],
-        "episodes": [per-episode values]}: std over tests, and a 95 % bootstrap interval of the
-        mean over the episodes themselves (:func:`interval95`; the episodes a metric counts,
+        "episodes": [per-episode values]}: std over tests, and a 95 % interval over the episodes
+        themselves (:func:`patrolsb3.stats.interval`: exact for the battery failure rate, the
+        bootstrap of the mean otherwise; the episodes a metric counts,
         kept so that the seeds of a zoo entry can be pooled: ``patrolsb3.zoo.pooled_result``), plus ``clean_episodes`` (per-test
         counts of episodes without a battery failure) and ``segments``.
     """
@@ -159,7 +152,7 @@ def summarize(per_episode: dict, tests: int) -> dict:
     clean = ~failed
     out = {}
 
-    def stats(values, episodes=None):
+    def stats(values, episodes=None, metric=""):
         values = np.asarray(values, dtype=np.float64)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
@@ -168,7 +161,7 @@ def summarize(per_episode: dict, tests: int) -> dict:
                       "tests": [float(v) for v in values]}
         if episodes is not None:
             episodes = np.asarray(episodes, dtype=np.float64)
-            result["ci95"] = interval95(episodes)
+            result["ci95"] = interval(metric, episodes)          # exact for a rate
             result["episodes"] = [float(v) for v in episodes]    # what seeds are pooled from
         return result
 
@@ -185,7 +178,8 @@ def summarize(per_episode: dict, tests: int) -> dict:
         out[f"{name}_all"] = stats(values.reshape(tests, -1).mean(axis=1), values)
     out["battery_failures"] = stats(per_episode["battery_failures"].reshape(tests, -1).mean(axis=1),
                                     per_episode["battery_failures"])
-    out["battery_failure_rate"] = stats(failed.mean(axis=1), failed.reshape(-1).astype(np.float64))
+    out["battery_failure_rate"] = stats(failed.mean(axis=1), failed.reshape(-1).astype(np.float64),
+                                        metric="battery_failure_rate")
     swaps = per_episode["swaps"].reshape(tests, -1)
     level = np.nan_to_num(per_episode["swap_battery"]).reshape(tests, -1) * swaps
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -135,6 +135,16 @@ def read_eval_file(path) -> dict:
 
 def read_results(results: list) -> list:
     """Results read from JSON with their figures as written: a null inside a result's
-    ``summary`` (a figure that did not exist) back to NaN."""
-    return [{**r, "summary": _nan_for_null(r["summary"])} if isinstance(r, dict) and "summary" in r else r
-            for r in results]
+    ``summary`` (a figure that did not exist) back to NaN, and each rate's interval the exact one
+    of its per-episode values (:mod:`patrolsb3.stats`), whatever interval was stored with it."""
+    return [{**r, "summary": _exact_rates(_nan_for_null(r["summary"]))} if isinstance(r, dict) and "summary" in r
+            else r for r in results]
+
+
+def _exact_rates(summary: dict) -> dict:
+    from .stats import RATE_METRICS, rate_interval
+    for metric in RATE_METRICS:
+        figure = summary.get(metric) if isinstance(summary, dict) else None
+        if isinstance(figure, dict) and figure.get("episodes"):
+            figure["ci95"] = rate_interval(figure["episodes"])
+    return summary

@@ -667,7 +667,8 @@ def pooled_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
     episodes, so this is also the mean of the seeds' means when no episode is dropped) and its
     95 % interval is scipy's bootstrap over them (:func:`patrolsb3.evaluate.interval95`), each
     (seed, episode) one draw: the spread between seeds enters through the episodes, not as a
-    separate level. ``summary[metric]["tests"]`` holds the seeds' own means. With one usable seed
+    separate level (the battery failure rate's interval is exact: :mod:`patrolsb3.stats`).
+    ``summary[metric]["tests"]`` holds the seeds' own means. With one usable seed
     this is that seed's result unchanged.
 
     Returns:
@@ -675,7 +676,7 @@ def pooled_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
         and ``unpooled_seeds`` (seeds left out: no eval.json for this protocol, or one written
         before per-episode figures were stored), or None when no seed has such a result.
     """
-    from .evaluate import interval95
+    from .stats import interval
     usable, left_out = [], []
     for k in seeds(map_name, variant, zoo_dir):
         r = cached_result(map_name, variant, n_agents, episodes, steps, seed, tests, zoo_dir,
@@ -698,7 +699,7 @@ def pooled_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
             finite = pooled[np.isfinite(pooled)]
             summary[metric] = {"mean": float(finite.mean()) if len(finite) else float("nan"),
                                "std": float(np.nanstd(seed_means)), "tests": seed_means,
-                               "ci95": interval95(pooled), "episodes": [float(v) for v in pooled]}
+                               "ci95": interval(metric, pooled), "episodes": [float(v) for v in pooled]}
         elif metric == "clean_episodes":
             summary[metric] = [int(sum(r["summary"][metric])) for _, r in usable]
         else:

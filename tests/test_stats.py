@@ -1,0 +1,45 @@
+"""patrolsb3.stats: a rate gets its exact (Clopper-Pearson) interval everywhere it is summarised
+or read back, a mean its bootstrap interval."""
+import numpy as np
+import pytest
+
+from patrolsb3.outputs import read_results
+from patrolsb3.stats import interval, mean_interval, rate_interval
+
+
+def test_a_rate_of_0_in_30_has_an_exact_upper_bound_near_0_12():
+    low, high = rate_interval([0.0] * 30)
+    assert low == 0.0 and high == pytest.approx(0.1157, abs=1e-4)        # 1 - 0.025 ** (1 / 30)
+    assert high > 0.05                       # so it is not "clearly at most 0.05"
+    low, high = rate_interval([1.0] * 3 + [0.0] * 27)
+    assert low == pytest.approx(0.0211, abs=1e-3) and high == pytest.approx(0.2653, abs=1e-3)
+    assert rate_interval([]) != rate_interval([])                            # [nan, nan]
+    with pytest.raises(ValueError, match="0 or 1"):
+        rate_interval([0.5, 1.0])
+
+
+def test_each_metric_gets_its_interval():
+    values = [0.0, 1.0, 0.0, 0.0]
+    assert interval("battery_failure_rate", values) == rate_interval(values)
+    assert interval("avg_idleness", values) == mean_interval(values)
+    assert mean_interval([3.0] * 30) == [3.0, 3.0]
+
+
+def test_a_stored_rate_is_read_back_with_its_exact_interval():
+    stored = [{"strategy": "CR", "summary": {"battery_failure_rate": {"mean": 0.0, "ci95": [0.0, 0.0],
+                                                                      "episodes": [0.0] * 30},
+                                             "avg_idleness": {"mean": 5.0, "ci95": [4.0, 6.0],
+                                                              "episodes": [5.0] * 30}}}]
+    summary = read_results(stored)[0]["summary"]
+    assert summary["battery_failure_rate"]["ci95"][1] == pytest.approx(0.1157, abs=1e-4)
+    assert summary["avg_idleness"]["ci95"] == [4.0, 6.0]                      # a mean's stays as stored
+
+
+def test_an_evaluation_summarises_its_failure_rate_exactly():
+    from patrolsb3.evaluate import summarize
+    per_episode = {"failed": np.zeros(20, dtype=bool), "battery_failures": np.zeros(20), "swaps": np.zeros(20),
+                   "swap_battery": np.full(20, np.nan),
+                   **{k: np.ones(20) for k in ("avg_idleness", "max_idleness", "worst_idleness",
+                                               "std_idleness", "collisions")}}
+    rate = summarize(per_episode, tests=1)["battery_failure_rate"]
+    assert rate["mean"] == 0.0 and rate["ci95"][1] == pytest.approx(0.1684, abs=1e-3)   # 0 in 20
