@@ -236,23 +236,34 @@ def _error_bars(rows: list[dict], metric: str, means: np.ndarray):
     return None
 
 
+LEARNED_MARKERS = {"rl-msg": "s", "rl-no-msg": "^", "rl-intention": "D"}
+"""Markers of the learned variants' lines (a heuristic's is a circle), so that they are told
+apart without colour."""
+
+ERROR_BAR_CAPTION = ("error bars: 95 % interval of the mean over the episodes (zoo columns: the episodes of "
+                     "every training seed pooled); exact binomial for the battery failure rate")
+
+
 def plot_map(results: list[dict], map_name: str, path) -> Path:
-    """One PNG per map: MAX^h, AVG^h, collisions, battery failure rate and battery % at swap
-    start against team size, one line per strategy (std error bars over tests when there are
-    several). Idleness and collisions on a log scale, so that RANDOM (thousands) does not flatten
-    the others; the zoo models dashed with square markers, the heuristics solid."""
+    """One PNG per map, a grid of panels: MAX^h, AVG^h, collisions, battery failure rate and
+    battery % at swap start against team size, one line per strategy with its 95 % interval, and
+    the legend in a panel of its own (it hides no data). Idleness and collisions on a log scale,
+    so that RANDOM (thousands) does not flatten the others; the battery failure rate from 0 to 1.
+    The zoo models dashed, each variant with a marker of its own; the heuristics solid, circles."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     panels = ("max_idleness", "avg_idleness", "collisions", "battery_failure_rate", "swap_battery_pct")
-    fig, axes = plt.subplots(1, len(panels), figsize=(4 * len(panels), 3.5))
+    fig, grid = plt.subplots(2, 3, figsize=(12, 7))
+    axes, legend_ax = list(grid.flat[:len(panels)]), grid.flat[len(panels)]
     rows = [r for r in results if r["map"] == map_name]
     for strategy in sorted({r["strategy"] for r in rows}):
         mine = sorted((r for r in rows if r["strategy"] == strategy), key=lambda r: r["n_agents"])
         ns = [r["n_agents"] for r in mine]
         learned = strategy.startswith("zoo:")
-        style = dict(marker="s" if learned else "o", linestyle="--" if learned else "-",
+        variant = strategy.split(":")[1] if learned else ""
+        style = dict(marker=LEARNED_MARKERS.get(variant, "s") if learned else "o", linestyle="--" if learned else "-",
                      linewidth=2.0 if learned else 1.2, capsize=3, label=strategy)
         for ax, metric in zip(axes, panels):
             means = np.array([r["summary"][metric]["mean"] for r in mine], dtype=float)
@@ -260,12 +271,17 @@ def plot_map(results: list[dict], map_name: str, path) -> Path:
     for ax, metric in zip(axes, panels):
         if metric in ("max_idleness", "avg_idleness", "collisions"):
             ax.set_yscale("symlog" if metric == "collisions" else "log")
+        if metric == "battery_failure_rate":
+            ax.set_ylim(0.0, max(0.1, min(1.0, ax.get_ylim()[1])))
         ax.set_title(LABELS[metric] + (" (log)" if metric in ("max_idleness", "avg_idleness", "collisions") else ""))
         ax.set_xlabel("agents")
         ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=8)
+    handles, labels = axes[0].get_legend_handles_labels()
+    legend_ax.axis("off")
+    legend_ax.legend(handles, labels, loc="center", fontsize=9, title=f"map {map_name}")
     fig.suptitle(f"map {map_name}")
-    fig.tight_layout()
+    fig.text(0.5, 0.005, ERROR_BAR_CAPTION, ha="center", fontsize=8)
+    fig.tight_layout(rect=(0, 0.02, 1, 1))
     fig.savefig(path, dpi=80)
     plt.close(fig)
     return Path(path)
