@@ -1,19 +1,23 @@
 """The paper's claims, one row each, tested on a comparison's figures (``patrolsb3 claims``).
 
 Read from a comparison folder's ``results.csv`` (``patrolsb3 compare``): every (map, team
-size, strategy, metric) with its mean and 95 % interval (the interval of the mean over the
-comparison's episodes, scipy's bootstrap; one training seed per learned variant, so the
-interval covers episodes, not seeds). Idleness and collisions follow the paper's convention
-(episodes without a battery failure).
+size, strategy, metric) with its mean and 95 % interval. A heuristic's interval is over its
+episodes (scipy's bootstrap of the mean); a zoo column's is over its training seeds, each seed's
+mean one draw (Student's t: the training seed is the unit); a battery failure rate's is exact
+(Clopper-Pearson) over the episodes (:mod:`patrolsb3.stats`). Idleness and collisions follow
+the paper's convention (episodes without a battery failure).
 
 How a verdict is reached, per (map, team size) cell: one strategy is *significantly* lower
-than another when its whole interval lies below the other's. A claim that X is lowest
+than another when its whole interval lies below the other's and both cells are testable: at
+least 10 episodes, and for a zoo column at least 3 training seeds (fewer: "too few to test",
+counted in the figure; one seed gives a figure, not a verdict). A claim that X is lowest
 **holds** when X is significantly lowest in every cell it covers, **does not hold** when
 another strategy is significantly lower than X in some cell, and is **inconclusive** otherwise.
 A claim that X is *no worse* holds when no other strategy is significantly better in any cell.
 Thresholds (near-zero failures: a rate of 0.05 at most; recharge above b_l) hold when the
 whole interval is on the claimed side and fail when it is all on the other. A cell without an
-interval (a result stored before intervals existed) cannot be significant either way.
+interval (a result stored before intervals existed) cannot be significant either way. The
+comparisons are not yet paired nor adjusted for their number (issue 44).
 """
 from __future__ import annotations
 
@@ -34,10 +38,12 @@ HOLDS, FAILS, OPEN = "holds", "does not hold", "inconclusive"
 
 @dataclass(frozen=True)
 class Figure:
-    """A mean with its 95 % interval (nan when unknown)."""
+    """A mean with its 95 % interval (nan when unknown), and whether its cell has enough
+    episodes and training seeds to decide a comparison (:func:`patrolsb3.stats.testable`)."""
     mean: float
     low: float
     high: float
+    testable: bool = True
 
     def text(self, digits: int = 1) -> str:
         if math.isnan(self.mean):
@@ -48,8 +54,8 @@ class Figure:
 
 
 def below(a: Figure, b: Figure) -> bool:
-    """a is significantly lower than b (a's interval wholly below b's)."""
-    return not (math.isnan(a.high) or math.isnan(b.low)) and a.high < b.low
+    """a is significantly lower than b (a's interval wholly below b's, both cells testable)."""
+    return a.testable and b.testable and not (math.isnan(a.high) or math.isnan(b.low)) and a.high < b.low
 
 
 def read_figures(results_csv) -> dict:
@@ -77,14 +83,23 @@ def read_figures(results_csv) -> dict:
             if reader.fieldnames is None or not set(needed) <= set(reader.fieldnames):
                 raise ValueError(f"its columns are {reader.fieldnames}, not {list(needed)} ...")
             figures = {(r["map"], int(r["n"]), r["strategy"], r["metric"]):
-                       Figure(number(r["mean"]), number(r.get("ci95_low")), number(r.get("ci95_high")))
-                       for r in reader}
+                       Figure(number(r["mean"]), number(r.get("ci95_low")), number(r.get("ci95_high")),
+                              _testable(r)) for r in reader}
     except (ValueError, TypeError, UnicodeDecodeError, csv.Error) as exc:
         raise ValueError(f"{path}: not a results.csv written by 'patrolsb3 compare', or cut or damaged ({exc}); "
                          f"run the comparison again") from None
     if not figures:
         raise ValueError(f"{path}: holds no results; run the comparison again")
     return figures
+
+
+def _testable(row: dict) -> bool:
+    """A results.csv row's cell has the episodes and training seeds to decide (a file written
+    before those columns existed: yes, as it was read then)."""
+    from .stats import testable
+    episodes = int(row["episodes"]) if (row.get("episodes") or "").strip() else 10 ** 9
+    seeds = (row.get("training_seeds") or "").strip()
+    return testable(episodes, int(seeds) if seeds else None)
 
 
 def _cells(figures: dict, who: str, metric: str, maps=None, sizes=None) -> list[tuple[str, int]]:
@@ -96,7 +111,7 @@ def _cells(figures: dict, who: str, metric: str, maps=None, sizes=None) -> list[
 def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, highest: bool = False) -> dict:
     """Whether ``who`` has the lowest (or ``highest``) ``metric`` against ``rivals`` in every
     cell: {"verdict", "figure", "cells"} (module docstring)."""
-    wins = losses = compared = unmeasured = 0
+    wins = losses = compared = unmeasured = too_few = 0
     worst = None
     for m, n in _cells(figures, who, metric, maps, sizes):
         mine = figures[(m, n, who, metric)]
@@ -106,6 +121,7 @@ def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, 
             continue
         compared += 1
         unmeasured += any(math.isnan(f.low) for f in (mine, *others.values()))
+        too_few += not all(f.testable for f in (mine, *others.values()))
         better = (lambda a, b: below(b, a)) if highest else below       # a beats b
         if all(better(mine, o) for o in others.values()):
             wins += 1
@@ -122,6 +138,8 @@ def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, 
     figure = f"significantly {word} in {wins} of {compared} cells; significantly beaten in {losses}"
     if unmeasured:
         figure += f"; {unmeasured} cells without an interval"
+    if too_few:
+        figure += f"; {too_few} cells too few to test (fewer than 3 training seeds or 10 episodes)"
     if worst:
         figure += f" (e.g. {worst})"
     verdict = FAILS if losses else HOLDS if wins == compared else OPEN
@@ -138,17 +156,19 @@ def no_worse(figures: dict, who: str, rivals, metric: str, maps=None) -> dict:
 
 def threshold(figures: dict, who_list, metric: str, limit: float, above: bool, maps=None) -> dict:
     """Whether every cell of ``who_list`` has ``metric`` above (or at most) ``limit``."""
-    held = failed = compared = unmeasured = 0
+    held = failed = compared = unmeasured = too_few = 0
     example = None
     for who in who_list:
         for m, n in _cells(figures, who, metric, maps):
             f = figures[(m, n, who, metric)]
             compared += 1
             unmeasured += math.isnan(f.low)
+            too_few += not f.testable
             if above:
                 ok, bad = f.low > limit, f.high < limit
             else:
                 ok, bad = f.high <= limit, f.low > limit
+            ok, bad = ok and f.testable, bad and f.testable
             held += ok
             failed += bad
             if bad and example is None:
@@ -158,6 +178,8 @@ def threshold(figures: dict, who_list, metric: str, limit: float, above: bool, m
     figure = f"{held} of {compared} cells clearly {'above' if above else 'at or below'} {limit:g}, {failed} clearly not"
     if unmeasured:
         figure += f"; {unmeasured} cells without an interval"
+    if too_few:
+        figure += f"; {too_few} cells too few to test"
     if example:
         figure += f" (e.g. {example})"
     return {"verdict": FAILS if failed else HOLDS if held == compared else OPEN, "figure": figure,

@@ -202,15 +202,16 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
     with long_path.open("w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(["map", "n", "strategy", "metric", "mean", "std", "ci95_low", "ci95_high",
-                         "clean_episodes", "episodes", "tests", "steps", "deterministic"])
+                         "clean_episodes", "episodes", "tests", "steps", "deterministic", "training_seeds"])
         for r in results:
             metrics = [m for m, v in r["summary"].items() if isinstance(v, dict) and "mean" in v]
             for metric in metrics:                 # LABELS' metrics and their *_all twins
                 s = r["summary"][metric]
                 low, high = s.get("ci95") or ("", "")   # results stored before the intervals have none
+                seeds = len(r.get("training_seeds") or [0]) if str(r["strategy"]).startswith("zoo:") else ""
                 writer.writerow([r["map"], r["n_agents"], r["strategy"], metric, s["mean"], s["std"], low, high,
                                  sum(r["summary"]["clean_episodes"]), r["episodes"] * r["tests"],
-                                 r["tests"], r["steps"], r.get("deterministic", True)])
+                                 r["tests"], r["steps"], r.get("deterministic", True), seeds])
     written.append(long_path)
     if any(str(r.get("strategy", "")).startswith("zoo:") for r in results):   # the claims head the report
         from .claims import claims, claims_table, read_figures

@@ -52,3 +52,37 @@ def interval(metric: str, values) -> list:
     """The 95 % interval of a summary metric's per-episode ``values``: exact for a rate
     (:data:`RATE_METRICS`), the bootstrap of the mean otherwise."""
     return rate_interval(values) if metric in RATE_METRICS else mean_interval(values)
+
+
+MIN_SEEDS = 3
+"""Training seeds a learned column needs before its figures can decide a comparison."""
+MIN_EPISODES = 10
+"""Episodes a cell needs before its figures can decide a comparison."""
+
+
+def seed_interval(seed_means) -> list:
+    """95 % interval of the mean over training seeds, each seed's mean one draw (Student's t with
+    seeds - 1 degrees of freedom, scipy): the training seed is the unit, so a seed far from the
+    others widens the interval instead of being outvoted by its episodes. [nan, nan] below two
+    finite seed means.
+
+    >>> [round(v, 1) for v in seed_interval([425.1, 424.5, 329.9])]
+    [257.0, 529.3]
+    """
+    values = np.asarray(seed_means, dtype=np.float64)
+    values = values[np.isfinite(values)]
+    if len(values) < 2:
+        return [float("nan"), float("nan")]
+    mean = float(values.mean())
+    sem = float(values.std(ddof=1) / np.sqrt(len(values)))
+    if sem == 0.0:
+        return [mean, mean]
+    from scipy.stats import t
+    low, high = t.interval(0.95, len(values) - 1, loc=mean, scale=sem)
+    return [float(low), float(high)]
+
+
+def testable(episodes: int, training_seeds: int | None) -> bool:
+    """Whether a cell's figures may decide a comparison: at least :data:`MIN_EPISODES` episodes
+    and, for a learned column (``training_seeds`` not None), :data:`MIN_SEEDS` training seeds."""
+    return episodes >= MIN_EPISODES and (training_seeds is None or training_seeds >= MIN_SEEDS)

@@ -662,21 +662,22 @@ def pooled_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
                   tests: int = 1, zoo_dir=None, deterministic: bool = True):
     """The paper-setting entry's figures pooled over its training seeds, from their eval.json.
 
-    Every seed whose eval.json holds this protocol and per-episode figures contributes its
-    episodes: each metric's mean is the mean over all of them (every seed has the same number of
-    episodes, so this is also the mean of the seeds' means when no episode is dropped) and its
-    95 % interval is scipy's bootstrap over them (:func:`patrolsb3.evaluate.interval95`), each
-    (seed, episode) one draw: the spread between seeds enters through the episodes, not as a
-    separate level (the battery failure rate's interval is exact: :mod:`patrolsb3.stats`).
-    ``summary[metric]["tests"]`` holds the seeds' own means. With one usable seed
-    this is that seed's result unchanged.
+    Every seed whose eval.json holds this protocol and per-episode figures contributes. The
+    training seed is the unit: a mean metric's figure is the mean of the seeds' means and its 95 %
+    interval Student's t over them (:func:`patrolsb3.stats.seed_interval`), so two seeds far
+    apart give a wide interval that contains both. A rate (the battery failure rate) pools the
+    seeds' episodes and takes the exact binomial interval (:func:`patrolsb3.stats.rate_interval`):
+    with three seeds of 10 episodes, a t over three rates of 0 would say [0, 0].
+    ``summary[metric]["tests"]`` holds the seeds' own means, ``["episodes"]`` every episode. With
+    one usable seed this is that seed's result unchanged (its intervals are over its episodes:
+    a figure, not a verdict; ``claims`` tests no cell below three seeds).
 
     Returns:
         The result dict (like :func:`cached_result`) with ``training_seeds`` (the seeds pooled)
         and ``unpooled_seeds`` (seeds left out: no eval.json for this protocol, or one written
         before per-episode figures were stored), or None when no seed has such a result.
     """
-    from .stats import interval
+    from .stats import RATE_METRICS, rate_interval, seed_interval
     usable, left_out = [], []
     for k in seeds(map_name, variant, zoo_dir):
         r = cached_result(map_name, variant, n_agents, episodes, steps, seed, tests, zoo_dir,
@@ -696,10 +697,15 @@ def pooled_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
             pooled = np.concatenate([np.asarray(r["summary"][metric]["episodes"], dtype=np.float64)
                                      for _, r in usable])                     # (seeds x episodes,)
             seed_means = [float(r["summary"][metric]["mean"]) for _, r in usable]
-            finite = pooled[np.isfinite(pooled)]
-            summary[metric] = {"mean": float(finite.mean()) if len(finite) else float("nan"),
-                               "std": float(np.nanstd(seed_means)), "tests": seed_means,
-                               "ci95": interval(metric, pooled), "episodes": [float(v) for v in pooled]}
+            finite_means = [m for m in seed_means if np.isfinite(m)]
+            if metric in RATE_METRICS:        # a rate: every episode a 0 or a 1, the exact interval
+                finite = pooled[np.isfinite(pooled)]
+                mean, ci = (float(finite.mean()) if len(finite) else float("nan")), rate_interval(pooled)
+            else:                             # a mean: the training seed is the unit
+                mean = float(np.mean(finite_means)) if finite_means else float("nan")
+                ci = seed_interval(seed_means)
+            summary[metric] = {"mean": mean, "std": float(np.nanstd(seed_means)), "tests": seed_means,
+                               "ci95": ci, "episodes": [float(v) for v in pooled]}
         elif metric == "clean_episodes":
             summary[metric] = [int(sum(r["summary"][metric])) for _, r in usable]
         else:

@@ -43,3 +43,30 @@ def test_an_evaluation_summarises_its_failure_rate_exactly():
                                                "std_idleness", "collisions")}}
     rate = summarize(per_episode, tests=1)["battery_failure_rate"]
     assert rate["mean"] == 0.0 and rate["ci95"][1] == pytest.approx(0.1684, abs=1e-3)   # 0 in 20
+
+
+def test_an_interval_over_seeds_contains_the_seed_means_of_a_bimodal_case():
+    from patrolsb3.stats import seed_interval
+    seeds = [425.1, 424.5, 329.9]                      # A, rl-msg, one agent, MAX^h
+    low, high = seed_interval(seeds)
+    assert low < min(seeds) and high > max(seeds)
+    # what the pooled-episode bootstrap said: an interval that excludes a seed's own mean
+    rng = np.random.default_rng(0)
+    episodes = np.concatenate([rng.normal(m, 5.0, 10) for m in seeds])
+    pooled = mean_interval(episodes)
+    assert not pooled[0] <= 329.9 <= pooled[1]
+    assert np.isnan(seed_interval([400.0])[0])        # one seed: no interval over seeds
+
+
+def test_too_few_to_test_below_the_floor():
+    from patrolsb3.claims import Figure, below, lowest
+    from patrolsb3.stats import testable
+    assert testable(10, None) and testable(10, 3)
+    assert not testable(9, None) and not testable(10, 2) and not testable(10, 1)
+    low, high = Figure(1.0, 0.9, 1.1), Figure(5.0, 4.9, 5.1)
+    assert below(low, high)
+    assert not below(Figure(1.0, 0.9, 1.1, testable=False), high)      # clearly apart, but too few
+    figures = {("A", 1, "zoo:rl-msg", "max_idleness"): Figure(1.0, 0.9, 1.1, testable=False),
+               ("A", 1, "CR", "max_idleness"): high}
+    result = lowest(figures, "zoo:rl-msg", ["CR"], "max_idleness")
+    assert result["verdict"] == "inconclusive" and "1 cells too few to test" in result["figure"]
