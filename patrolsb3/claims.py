@@ -26,11 +26,14 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from .names import display_name
+
 MSG, NOMSG, INTENTION = "zoo:rl-msg", "zoo:rl-no-msg", "zoo:rl-intention"
 LEARNED = (MSG, NOMSG, INTENTION)
 HEURISTICS = ("CR", "PART", "SEBS")
 PAPER_STRATEGIES = HEURISTICS + LEARNED
-LABEL = {MSG: "RL-MSG", NOMSG: "RL-NO-MSG", INTENTION: "RL-INTENTION", "CR": "CR", "PART": "PART", "SEBS": "SEBS"}
+LABEL = {name: display_name(name) for name in PAPER_STRATEGIES}
+"""How each strategy is named in a claim (:func:`patrolsb3.names.display_name`)."""
 NEAR_ZERO = 0.05
 """A battery failure rate 'near zero' (the paper's word) is at most this."""
 HOLDS, FAILS, OPEN = "holds", "does not hold", "inconclusive"

@@ -3,7 +3,9 @@
 * :func:`evaluation_text` — the terminal / markdown table of one ``evaluate()`` result.
 * :func:`write_compare` — per map the paper's CSV tables ``<MAP>-BF.csv``, ``-BLv.csv``,
   ``-MAX.csv``, ``-MEAN.csv``, ``-COLLISION.csv`` with columns ``n,CR,PART,SEBS,INTENTION,
-  NOMSG,MSG`` (cells are means over tests; a strategy that was not run is an empty cell),
+  NOMSG,MSG`` (cells are means over tests; a strategy that was not run is an empty cell; the
+  column names are the paper's data-file names, which its LaTeX tables read, while every table
+  of ``report.md`` and every plot says RL-INTENTION, RL-NO-MSG, RL-MSG: :mod:`patrolsb3.names`),
   the same tables for the extra strategies in ``<MAP>-<TABLE>-extra.csv`` (columns
   ``n,RANDOM,CYCLIC``), every figure with its std over tests and its 95 % interval over
   episodes in ``results.csv`` (long format), one
@@ -17,6 +19,8 @@ import math
 
 import numpy as np
 from pathlib import Path
+
+from .names import display_name
 
 PAPER_TABLES = {"BF": "battery_failure_rate", "BLv": "swap_battery_pct", "MAX": "max_idleness",
                 "MEAN": "avg_idleness", "COLLISION": "collisions"}
@@ -181,7 +185,7 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
                 written.append(path)
             rows_all = _table_rows(results, m, metric, PAPER_COLUMNS + extra_columns)
             digits = 3 if metric == "battery_failure_rate" else 1
-            md.append("| n | " + " | ".join(PAPER_COLUMNS + extra_columns) + " |")
+            md.append("| n | " + " | ".join(display_name(c) for c in PAPER_COLUMNS + extra_columns) + " |")
             md.append("|---" * (1 + len(PAPER_COLUMNS + extra_columns)) + "|")
             for row in rows_all:
                 cells = _best_marked([mean_std(s, digits) for s in row[1:]], row[1:], metric)
@@ -265,7 +269,7 @@ def plot_map(results: list[dict], map_name: str, path) -> Path:
         learned = strategy.startswith("zoo:")
         variant = strategy.split(":")[1] if learned else ""
         style = dict(marker=LEARNED_MARKERS.get(variant, "s") if learned else "o", linestyle="--" if learned else "-",
-                     linewidth=2.0 if learned else 1.2, capsize=3, label=strategy)
+                     linewidth=2.0 if learned else 1.2, capsize=3, label=display_name(strategy))
         for ax, metric in zip(axes, panels):
             means = np.array([r["summary"][metric]["mean"] for r in mine], dtype=float)
             ax.errorbar(ns, means, yerr=_error_bars(mine, metric, means), **style)

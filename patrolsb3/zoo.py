@@ -45,6 +45,17 @@ ZOO_ENV = "PATROLSB3_ZOO"
 """Environment variable naming a zoo folder (e.g. a clone's ``zoo/``) for an installed package."""
 
 
+def training_map(config: dict):
+    """The map a run or entry was trained on, from its config.yml: the map file if it is still
+    there, else the map text it recorded (a map not shipped), else the shipped map by name."""
+    source = config.get("map_source")
+    if source and Path(source).is_file():
+        return source
+    if config.get("map_text"):
+        return parse_map(config["map_text"], name=config["map"], source=str(source or "<config.yml>"))
+    return config["map"]
+
+
 def use_zoo_dir(zoo_dir) -> None:
     """Make ``zoo_dir`` the zoo of this process and the processes it starts (Ray's included):
     what a command's ``--zoo-dir`` does, through ``$PATROLSB3_ZOO``.
@@ -427,14 +438,8 @@ def load_checkpoint(path, spec=None) -> ZooPolicy:
                        f"{ENV_VERSION!r}; retrain it or use a matching patrolsb3 release")
     if not zip_is_intact(path):
         raise ZooError(f"{path}: the file is empty, cut or corrupt (its zip check fails)")
-    if spec is None:   # the training map file if it is still there, else its text, else the map by name
-        source = config.get("map_source")
-        if source and Path(source).is_file():
-            spec = source
-        elif config.get("map_text"):
-            spec = parse_map(config["map_text"], name=config["map"], source=str(source or "<config.yml>"))
-        else:
-            spec = config["map"]
+    if spec is None:
+        spec = training_map(config)
     spec = checked_map(config, spec, path)
     import torch
     torch.set_num_threads(1)
@@ -515,14 +520,8 @@ def load_entry(folder, spec=None, device: str = "cpu") -> ZooPolicy:
     if version != ENV_VERSION:
         raise ZooError(f"{folder}: trained for env version {version!r}, this code is {ENV_VERSION!r}; "
                        f"retrain it or use a matching patrolsb3 release")
-    if spec is None:   # the training map file if it is still there, else its text, else the map by name
-        source = config.get("map_source")
-        if source and Path(source).is_file():
-            spec = source
-        elif config.get("map_text"):
-            spec = parse_map(config["map_text"], name=config["map"], source=str(source or "<config.yml>"))
-        else:
-            spec = config["map"]
+    if spec is None:
+        spec = training_map(config)
     spec = checked_map(config, spec, folder)
     cfg = env_config(config)
     import torch

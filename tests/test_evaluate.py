@@ -138,7 +138,7 @@ def test_compare_shows_the_guarded_entries_only_when_asked_and_labelled(tmp_path
     main = list(csv.reader((tmp_path / "g" / "A-MAX.csv").open()))
     assert main[1][main[0].index("MSG")] == ""                   # the shield never fills the paper's column
     report = (tmp_path / "g" / "report.md").read_text()
-    assert "map A, zoo:rl-msg:guarded: behind the return guard" in report and "| MSG-GUARDED |" in report
+    assert "map A, zoo:rl-msg:guarded: behind the return guard" in report and "| RL-MSG (guarded) |" in report
     assert cli.main(["compare", "--maps", "A", "--agents", "1", "--episodes", "1", "--steps", "5",
                      "--strategies", "zoo:rl-msg:shielded", "--out", str(tmp_path / "bad")]) == 2
     assert "unknown suffix 'shielded'" in capsys.readouterr().err and not (tmp_path / "bad").exists()
