@@ -123,8 +123,9 @@ def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, 
         if not others:
             continue
         compared += 1
-        unmeasured += any(math.isnan(f.low) for f in (mine, *others.values()))
-        too_few += not all(f.testable for f in (mine, *others.values()))
+        cell_testable = all(f.testable for f in (mine, *others.values()))
+        too_few += not cell_testable
+        unmeasured += cell_testable and any(math.isnan(f.low) for f in (mine, *others.values()))
         better = (lambda a, b: below(b, a)) if highest else below       # a beats b
         if all(better(mine, o) for o in others.values()):
             wins += 1
@@ -165,7 +166,7 @@ def threshold(figures: dict, who_list, metric: str, limit: float, above: bool, m
         for m, n in _cells(figures, who, metric, maps):
             f = figures[(m, n, who, metric)]
             compared += 1
-            unmeasured += math.isnan(f.low)
+            unmeasured += f.testable and math.isnan(f.low)
             too_few += not f.testable
             if above:
                 ok, bad = f.low > limit, f.high < limit
@@ -198,23 +199,30 @@ def both(*parts: dict) -> dict:
 
 
 def training_reward(curves: dict, fraction: float = 0.2) -> dict:
-    """Whether RL-MSG's training reward (mean team reward of the last ``fraction`` of its
-    training episodes, with a 95 % interval over them) is the highest, per map.
+    """Whether RL-MSG's training reward is the highest, per map: each training seed's figure is
+    the mean team reward of the last ``fraction`` of its training episodes, and a variant's is
+    the mean over its seeds with Student's t over them (the training seed is the unit; fewer
+    than 3 seeds: too few to test).
 
     Args:
-        curves: {map: {variant: curve.csv path}}.
+        curves: {map: {variant: curve.csv path, or a list of them, one a training seed}}.
     """
-    from .evaluate import interval95
+    from .runs import read_curve
+    from .stats import MIN_SEEDS, seed_interval
     figures = {}
     for m, by_variant in curves.items():
-        for variant, path in by_variant.items():
-            from .runs import read_curve
-            rewards = list(read_curve(path).get("reward", []))
-            if not rewards:
+        for variant, paths in by_variant.items():
+            tails = []
+            for path in ([paths] if isinstance(paths, (str, Path)) else paths):
+                rewards = list(read_curve(path).get("reward", []))
+                if rewards:
+                    tail = rewards[-max(1, int(len(rewards) * fraction)):]
+                    tails.append(sum(tail) / len(tail))
+            if not tails:
                 continue
-            tail = rewards[-max(1, int(len(rewards) * fraction)):]
-            low, high = interval95(tail)
-            figures[(m, 0, f"zoo:{variant}", "training_reward")] = Figure(sum(tail) / len(tail), low, high)
+            low, high = seed_interval(tails)
+            figures[(m, 0, f"zoo:{variant}", "training_reward")] = Figure(
+                sum(tails) / len(tails), low, high, testable=len(tails) >= MIN_SEEDS)
     return lowest(figures, MSG, LEARNED, "training_reward", highest=True)
 
 

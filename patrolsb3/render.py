@@ -372,11 +372,13 @@ def training_axis(data: dict) -> tuple[np.ndarray, np.ndarray, str]:
 
 def plot_learning_curves(curves: dict, path, title: str = "", window: int = 50) -> Path:
     """The paper's training figure: episode return (cumulative team reward per episode),
-    smoothed over the last ``window`` episodes, against simulator steps (:func:`training_axis`),
-    one line per variant.
+    smoothed over the last ``window`` episodes, against simulator steps (:func:`training_axis`).
+    A variant with one curve is one line; one with several training seeds shows every seed
+    (thin, named by its folder), their mean on a common axis (thick) and a band from the lowest
+    to the highest seed, up to the steps every seed reached.
 
     Args:
-        curves: label -> path of a curve.csv.
+        curves: label -> path of a curve.csv, or a list of paths (one a training seed).
         path: PNG to write.
         title: figure title (e.g. the map).
         window: episodes in the trailing mean.
@@ -387,20 +389,37 @@ def plot_learning_curves(curves: dict, path, title: str = "", window: int = 50) 
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6, 3.6), dpi=100)
+    fig, ax = plt.subplots(figsize=(7, 6), dpi=100)
     xlabels = set()
-    for label, csv_path in curves.items():
-        data = read_curve(csv_path)
-        if not data:
+    for label, paths in curves.items():
+        paths = [paths] if isinstance(paths, (str, Path)) else list(paths)
+        lines = []                                             # (x (N,), smoothed reward (N,), seed name)
+        for csv_path in paths:
+            data = read_curve(csv_path)
+            if not data:
+                continue
+            order, x, xlabel = training_axis(data)
+            xlabels.add(xlabel)
+            lines.append((x, trailing_mean(data["reward"][order], window), Path(csv_path).parent.name))
+        if not lines:
             continue
-        order, x, xlabel = training_axis(data)
-        xlabels.add(xlabel)
-        ax.plot(x, trailing_mean(data["reward"][order], window), label=label)
+        if len(lines) == 1:
+            ax.plot(lines[0][0], lines[0][1], label=label)
+            continue
+        color = ax.plot([], [])[0].get_color()
+        for x, y, seed in lines:
+            ax.plot(x, y, color=color, linewidth=0.6, alpha=0.45, label=f"{label} {seed}")
+        end = min(x[-1] for x, _, _ in lines)
+        grid = np.linspace(max(x[0] for x, _, _ in lines), end, 200)                     # (200,)
+        on_grid = np.array([np.interp(grid, x, y) for x, y, _ in lines])                 # (seeds, 200)
+        ax.fill_between(grid, on_grid.min(axis=0), on_grid.max(axis=0), color=color, alpha=0.15)
+        ax.plot(grid, on_grid.mean(axis=0), color=color, linewidth=2.2,
+                label=f"{label}: mean of {len(lines)} seeds (band: lowest to highest)")
     ax.set_xlabel(" / ".join(sorted(xlabels)) or "agent-steps")
     ax.set_ylabel(f"episode reward (mean of last {window})")
     ax.set_title(title)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.14))   # below: it hides no data
     fig.tight_layout()
     path = Path(path)
     fig.savefig(path)

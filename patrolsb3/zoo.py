@@ -134,6 +134,16 @@ def seeds(map_name: str, variant: str, zoo_dir=None, guard: bool = False) -> lis
     return sorted(int(p.parent.name[4:]) for p in folder.glob("seed*/model.zip") if p.parent.name[4:].isdigit())
 
 
+def seed_curves(map_name: str, variant: str, zoo_dir=None, guard: bool = False) -> list[Path]:
+    """The curve.csv of every training seed of an entry (the paper's setting; a guarded entry's
+    one), in seed order; [] when there is none."""
+    if guard:
+        path = entry_dir(map_name, variant, zoo_dir, guard=True) / "curve.csv"
+        return [path] if path.is_file() else []
+    found = [entry_dir(map_name, variant, zoo_dir, seed=k) / "curve.csv" for k in seeds(map_name, variant, zoo_dir)]
+    return [p for p in found if p.is_file()]
+
+
 def default_seed(map_name: str, variant: str, zoo_dir=None) -> dict | None:
     """The paper-setting entry's default seed: ``{"seed": k, "chosen_by": text}`` from its
     ``default.yml``, else its only seed; None when it has no seed.

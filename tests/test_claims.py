@@ -139,3 +139,19 @@ def test_lowest_restricted_to_sizes(sizes):
     figures = {("A", 1, "me", "x"): fig(1), ("A", 1, "you", "x"): fig(5), ("A", 3, "me", "x"): fig(9),
                ("A", 3, "you", "x"): fig(1)}
     assert lowest(figures, "me", ["you"], "x", sizes=sizes)["verdict"] == HOLDS
+
+
+def test_the_training_reward_claim_takes_every_seed_as_a_unit(tmp_path):
+    from patrolsb3.claims import training_reward
+
+    def curve(name, rewards):
+        path = tmp_path / name / "curve.csv"
+        path.parent.mkdir(parents=True)
+        path.write_text("timesteps,reward\n" + "".join(f"{10 * (i + 1)},{r}\n" for i, r in enumerate(rewards)))
+        return path
+    msg = [curve(f"msg{k}", [0, 0, 0, 0, v]) for k, v in enumerate((100.0, 101.0, 99.0))]
+    nomsg = [curve(f"nomsg{k}", [0, 0, 0, 0, v]) for k, v in enumerate((50.0, 52.0, 48.0))]
+    result = training_reward({"A": {"rl-msg": msg, "rl-no-msg": nomsg}})
+    assert result["verdict"] == "holds"                          # three seeds each, far apart
+    result = training_reward({"A": {"rl-msg": msg, "rl-no-msg": nomsg[:1]}})
+    assert result["verdict"] == "inconclusive" and "too few to test" in result["figure"]   # one seed: a figure only

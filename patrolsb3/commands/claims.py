@@ -26,9 +26,9 @@ def run(args):
                    if name.endswith(suffix) or not name.startswith("zoo:")
                    or not any(k[2] == name + suffix for k in figures)}
     faults = read_faults_result(args.faults_result) if args.faults_result else None
-    curves = {m: {v: p for v in zoo.VARIANT_NAMES
+    curves = {m: {v: found for v in zoo.VARIANT_NAMES
                   if zoo.available(m, v, args.zoo_dir, guard=args.guarded)
-                  and (p := zoo.entry_dir(m, v, args.zoo_dir, guard=args.guarded) / "curve.csv").is_file()}
+                  and (found := zoo.seed_curves(m, v, args.zoo_dir, guard=args.guarded))}
               for m in sorted({k[0] for k in figures})}
     rows = claims(figures, curves=curves, faults_result=faults)
     print(claims_table(rows))

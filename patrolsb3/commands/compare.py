@@ -224,12 +224,12 @@ def run(args):
     zoo_notes = {(m.upper(), name): zoo_note(zoo, m, name, reused=bool(sources.get((m, name, n))),
                                              pooled=pooled.get((m.upper(), name)))
                  for m, name, n in cells if name.startswith("zoo:")}
-    curves = {}                      # {MAP: {variant (or variant:guarded): curve.csv}} of the zoo columns
+    curves = {}              # {MAP: {variant (or variant:guarded): [curve.csv of every seed]}} of the zoo columns
     for m, name, n in cells:
         if name.startswith("zoo:"):
             variant, guard = zoo.parse_strategy(name)
-            if (path := zoo.entry_dir(m, variant, guard=guard) / "curve.csv").is_file():
-                curves.setdefault(m.upper(), {})[name[4:]] = path
+            if found := zoo.seed_curves(m, variant, guard=guard):
+                curves.setdefault(m.upper(), {})[name[4:]] = found
     paths = write_compare(results, args.out, learning_curves=curves, zoo_notes=zoo_notes,
                           faults_result=faults)
     print(f"wrote {len(paths)} files to {args.out} (report: {args.out}/report.md)")
