@@ -113,9 +113,11 @@ def _cells(figures: dict, who: str, metric: str, maps=None, sizes=None) -> list[
 
 def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, highest: bool = False) -> dict:
     """Whether ``who`` has the lowest (or ``highest``) ``metric`` against ``rivals`` in every
-    cell: {"verdict", "figure", "cells"} (module docstring)."""
-    wins = losses = compared = unmeasured = too_few = 0
-    worst = None
+    cell: {"verdict", "figure", "cells"} (module docstring). The figure says who wins where: the
+    cells where ``who`` is best, each rival that beats it and in which cells, the level cells,
+    and one example with both intervals."""
+    wins = losses = compared = unmeasured = too_few = level = 0
+    worst, beaten_by = None, {}                 # beaten_by: rival -> cells where it beats ``who``
     for m, n in _cells(figures, who, metric, maps, sizes):
         mine = figures[(m, n, who, metric)]
         others = {r: figures[(m, n, r, metric)] for r in rivals if (m, n, r, metric) in figures
@@ -130,16 +132,23 @@ def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, 
         if all(better(mine, o) for o in others.values()):
             wins += 1
         beaten = {r: o for r, o in others.items() if better(o, mine)}
+        where = f"{m}" + (f" n={n}" if n else "")
+        for r in beaten:
+            beaten_by.setdefault(r, []).append(where)
         if beaten:
             losses += 1
             if worst is None:
                 r, o = next(iter(beaten.items()))
-                where = f"map {m}" + (f" n={n}" if n else "")
-                worst = f"{where}: {LABEL.get(who, who)} {mine.text()} vs {LABEL.get(r, r)} {o.text()}"
+                worst = f"map {where}: {LABEL.get(who, who)} {mine.text()} vs {LABEL.get(r, r)} {o.text()}"
+        elif cell_testable and not all(better(mine, o) for o in others.values()):
+            level += 1
     if compared == 0:
         return {"verdict": OPEN, "figure": "not measured (no such cells in this comparison)", "cells": 0}
     word = "highest" if highest else "lowest"
     figure = f"significantly {word} in {wins} of {compared} cells; significantly beaten in {losses}"
+    if beaten_by:            # who wins where
+        figure += " (" + "; ".join(f"by {LABEL.get(r, r)} in {len(c)}: {', '.join(c)}" for r, c in beaten_by.items()) + ")"
+    figure += f"; level in {level}"
     if unmeasured:
         figure += f"; {unmeasured} cells without an interval"
     if too_few:
