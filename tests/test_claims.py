@@ -155,3 +155,13 @@ def test_the_training_reward_claim_takes_every_seed_as_a_unit(tmp_path):
     assert result["verdict"] == "holds"                          # three seeds each, far apart
     result = training_reward({"A": {"rl-msg": msg, "rl-no-msg": nomsg[:1]}})
     assert result["verdict"] == "inconclusive" and "too few to test" in result["figure"]   # one seed: a figure only
+
+
+def test_the_figure_says_who_wins_where():
+    from patrolsb3.claims import Figure, lowest
+    figures = {("A", 1, "zoo:rl-msg", "max_idleness"): Figure(5.0, 4.9, 5.1),
+               ("A", 1, "CR", "max_idleness"): Figure(1.0, 0.9, 1.1),
+               ("A", 2, "zoo:rl-msg", "max_idleness"): Figure(3.0, 2.0, 4.0),
+               ("A", 2, "CR", "max_idleness"): Figure(3.1, 2.1, 4.1)}
+    figure = lowest(figures, "zoo:rl-msg", ["CR"], "max_idleness")["figure"]
+    assert "significantly beaten in 1 (by CR in 1: A n=1); level in 1" in figure
