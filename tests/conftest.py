@@ -105,3 +105,25 @@ def middle_station_map():
 @pytest.fixture
 def room_map():
     return parse_map(ROOM, name="room")
+
+
+@pytest.fixture(scope="session")
+def tiny_zoo(tmp_path_factory):
+    """A zoo of its own for unit tests (not the committed one, which retraining changes): map A,
+    rl-msg and rl-no-msg, each a few hundred agent-steps of a small network with the zoo's
+    observation settings (symbol planes, local idleness), exported as seed 0.
+
+    Returns:
+        The zoo folder, for ``zoo.load("A", variant, zoo_dir=...)``.
+    """
+    from patrolsb3 import zoo
+    from patrolsb3.sb3.train import train
+    root = tmp_path_factory.mktemp("tiny_zoo")
+    hp = {"n_steps": 8, "n_minibatches": 1, "n_envs": 2, "eval_freq": 0, "checkpoint_freq": 10 ** 9,
+          "precision": "fp32", "env": {"episode_steps": 20, "message_encoding": "planes", "local_idleness": True},
+          "policy_kwargs": {"dense_sizes": [32, 16], "lstm_hidden_size": 8}}
+    for variant in ("rl-msg", "rl-no-msg"):
+        run = train(map="A", variant=variant, timesteps=160, run_dir=root / "runs" / variant, seed=0,
+                    hyperparams=hp, progress_bar=False)
+        zoo.export(run, zoo_dir=root / "zoo")
+    return root / "zoo"

@@ -61,16 +61,16 @@ def test_refusals():
 
 
 @pytest.mark.parametrize("variant", ["rl-msg"])
-def test_a_zoo_entry_gets_paired_changes_with_intervals(variant):
+def test_a_zoo_entry_gets_paired_changes_with_intervals(variant, tiny_zoo):
     from patrolsb3 import zoo
-    figures = message_ablation(zoo.load("A", variant), n_agents=2, episodes=2, steps=40, seed=5)
+    figures = message_ablation(zoo.load("A", variant, zoo_dir=tiny_zoo), n_agents=2, episodes=2, steps=40, seed=5)
     for mode in ("constant", "shuffled"):
         for metric, r in figures[mode].items():
             low, high = r["change_ci95"]
             assert low <= r["change"] <= high
             assert r["change"] == pytest.approx(r["mean"] - figures["baseline"][metric])
     with pytest.raises(ValueError, match="at least 2 agents"):
-        message_ablation(zoo.load("A", variant), n_agents=1)
+        message_ablation(zoo.load("A", variant, zoo_dir=tiny_zoo), n_agents=1)
 
 
 def test_cli_ablation_refuses_a_variant_without_messages(capsys):

@@ -26,13 +26,13 @@ def play(env, agent, seed):
     return np.array(idle), collisions
 
 
-def test_a_zoo_policy_in_pettingzoo_plays_the_evaluations_episode():
-    policy = zoo.load("A", "rl-msg")
+def test_a_zoo_policy_in_pettingzoo_plays_the_evaluations_episode(tiny_zoo):
+    policy = zoo.load("A", "rl-msg", zoo_dir=tiny_zoo)
     env = patrolsb3.parallel_env("A", n_agents=3, episode_steps=STEPS, **policy.env_settings())
     assert env.agents == [] and len(env.possible_agents) == 5
     idle, collisions = play(env, PettingZooAgent(policy, env), seed=4)
     cfg = make_config("A", **{**policy.env_settings(), "episode_steps": STEPS})
-    reference = run_episodes(zoo.load("A", "rl-msg"), policy.spec, cfg, 3, 1, seed=4)
+    reference = run_episodes(zoo.load("A", "rl-msg", zoo_dir=tiny_zoo), policy.spec, cfg, 3, 1, seed=4)
     assert idle.mean(axis=1).mean() == pytest.approx(reference["avg_idleness"][0], rel=1e-9)
     assert collisions == reference["collisions"][0]
     figures = play_episode(env, PettingZooAgent(policy, env), seed=4)
@@ -63,8 +63,8 @@ def test_a_heuristic_stays_silent_in_a_message_phase():
     env.step(actions)                                            # legal in the message phase
 
 
-def test_a_policy_refuses_an_env_with_other_observations():
-    policy = zoo.load("A", "rl-no-msg")
+def test_a_policy_refuses_an_env_with_other_observations(tiny_zoo):
+    policy = zoo.load("A", "rl-no-msg", zoo_dir=tiny_zoo)
     env = patrolsb3.parallel_env("A", n_agents=2, comm="learned")
     with pytest.raises(ValueError, match="env_settings"):
         PettingZooAgent(policy, env)

@@ -160,13 +160,13 @@ def test_n_minibatches_splits_the_deployed_rows():
     assert sum(sizes) == model.n_steps * 4 and len(sizes) == 3
 
 
-def test_a_zoo_model_zip_loads_as_an_sb3_model_and_acts_on_the_training_env():
+def test_a_zoo_model_zip_loads_as_an_sb3_model_and_acts_on_the_training_env(tiny_zoo):
     """SB3 users' way: MaskableRecurrentPPO.load(zoo model.zip) (a policy only), predict with
     action_masks on the training vec env's rows; with env= it trains on."""
     from patrolsb3 import zoo
-    entry = zoo.entry_dir("A", "rl-msg") / "model.zip"         # zoo/A/rl-msg/seed<k>/, the paper's setting
+    entry = zoo.entry_dir("A", "rl-msg", zoo_dir=tiny_zoo) / "model.zip"   # <zoo>/A/rl-msg/seed<k>/
     model = MaskableRecurrentPPO.load(entry, device="cpu")
-    policy = zoo.load("A", "rl-msg")
+    policy = zoo.load("A", "rl-msg", zoo_dir=tiny_zoo)
     settings = {k: v for k, v in policy.env_settings().items() if k != "comm"}
     venv = make_vec_env("A", agents=[3, 2], variant="rl-msg", seed=0, **settings)
     obs, masks = venv.reset(), venv.action_masks()
