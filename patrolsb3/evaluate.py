@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .names import is_learned
 from .core.config import make_config
 from .core.maps import load_map
 from .core.metrics import EpisodeMetrics, idleness_lower_bounds
@@ -59,7 +60,7 @@ def canonical_name(name: str) -> str:
     """The name tables use: heuristics in capitals ('sebs' -> 'SEBS'), zoo models as
     'zoo:<variant>' (or 'zoo:<variant>:guarded') in lower case."""
     name = str(name).strip()
-    if name.lower().startswith("zoo:"):
+    if is_learned(name):
         return name.lower()
     return name.upper()
 
@@ -72,7 +73,7 @@ def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0, device: str 
     Raises:
         ValueError: unknown strategy, or a zoo strategy when no zoo module or model exists.
     """
-    if str(name).lower().startswith("zoo:"):
+    if is_learned(name):
         try:
             zoo = importlib.import_module("patrolsb3.zoo")
         except ImportError as exc:

@@ -20,7 +20,7 @@ import math
 import numpy as np
 from pathlib import Path
 
-from .names import display_name
+from .names import display_name, is_learned
 
 PAPER_TABLES = {"BF": "battery_failure_rate", "BLv": "swap_battery_pct", "MAX": "max_idleness",
                 "MEAN": "avg_idleness", "COLLISION": "collisions"}
@@ -158,7 +158,7 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
                f"(map, strategy, team size); {spread}. Idleness and collision figures "
                f"average over episodes without a battery failure (counts in results.csv). The best "
                f"(lowest) value of each row is in bold.", ""]
-        learned = [r for r in results if str(r.get("strategy", "")).startswith("zoo:")]
+        learned = [r for r in results if is_learned(r.get("strategy", ""))]
         if learned:
             sampled = any(r.get("deterministic", True) is False for r in learned)
             md += [f"Zoo models {'sample their actions from the policy' if sampled else 'take their most likely legal action'}"
@@ -212,12 +212,12 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
             for metric in metrics:                 # LABELS' metrics and their *_all twins
                 s = r["summary"][metric]
                 low, high = s.get("ci95") or ("", "")   # results stored before the intervals have none
-                seeds = len(r.get("training_seeds") or [0]) if str(r["strategy"]).startswith("zoo:") else ""
+                seeds = len(r.get("training_seeds") or [0]) if is_learned(r["strategy"]) else ""
                 writer.writerow([r["map"], r["n_agents"], r["strategy"], metric, s["mean"], s["std"], low, high,
                                  sum(r["summary"]["clean_episodes"]), r["episodes"] * r["tests"],
                                  r["tests"], r["steps"], r.get("deterministic", True), seeds])
     written.append(long_path)
-    if any(str(r.get("strategy", "")).startswith("zoo:") for r in results):   # the claims head the report
+    if any(is_learned(r.get("strategy", "")) for r in results):   # the claims head the report
         from .claims import claims, claims_table, read_figures
         rows = claims(read_figures(long_path), curves=learning_curves, faults_result=faults_result)
         md[2:2] = ["## The paper's claims on these figures", "",
@@ -266,7 +266,7 @@ def plot_map(results: list[dict], map_name: str, path) -> Path:
     for strategy in sorted({r["strategy"] for r in rows}):
         mine = sorted((r for r in rows if r["strategy"] == strategy), key=lambda r: r["n_agents"])
         ns = [r["n_agents"] for r in mine]
-        learned = strategy.startswith("zoo:")
+        learned = is_learned(strategy)
         variant = strategy.split(":")[1] if learned else ""
         style = dict(marker=LEARNED_MARKERS.get(variant, "s") if learned else "o", linestyle="--" if learned else "-",
                      linewidth=2.0 if learned else 1.2, capsize=3, label=display_name(strategy))

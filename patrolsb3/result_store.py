@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from .names import is_learned
 from .core.config import ENV_VERSION, EnvConfig
 from .outputs import read_results, write_json
 
@@ -33,7 +34,7 @@ def protocol(result: dict) -> tuple:
     reused: those of :data:`PROTOCOL_KEYS` (env settings with defaults filled in:
     :func:`env_with_defaults`), the action mode for zoo models (heuristics ignore it) and the
     env version."""
-    learned = str(result["strategy"]).startswith("zoo:")
+    learned = is_learned(result["strategy"])
     fields = {k: result.get(k) for k in PROTOCOL_KEYS}
     fields["env"] = env_with_defaults(fields["env"])
     return (json.dumps([fields[k] for k in PROTOCOL_KEYS], sort_keys=True),

@@ -31,6 +31,8 @@ import yaml
 from .core import protocol
 from .core.config import ENV_VERSION, EnvConfig, make_config
 from .core.maps import MapSpec, load_map, parse_map
+from . import names
+from .names import GUARDED, VARIANT_NAMES, strategy_name  # noqa: F401 - the zoo's names, re-exported
 from .outputs import read_eval_file
 from .runs import read_config, write_atomically, zip_is_intact  # noqa: F401  (zoo.read_config is public)
 
@@ -91,35 +93,16 @@ def zoo_root(zoo_dir=None) -> Path:
                    f"folder, or give the zoo folder with --zoo-dir (commands) or zoo_dir= (Python)")
 
 
-VARIANT_NAMES = ("rl-msg", "rl-no-msg", "rl-intention")
-GUARDED = "guarded"
-"""Subfolder of the zoo holding the entries behind the return guard, and the strategy-name suffix
-that selects them (``zoo:rl-msg:guarded``)."""
 DEFAULT_FILE = "default.yml"
 """In a paper-setting entry folder: ``{seed: k, chosen_by: ...}``, the seed ``load`` uses by default."""
 
 
 def parse_strategy(name: str) -> tuple[str, bool]:
-    """``"zoo:rl-msg"`` -> ``("rl-msg", False)``; ``"zoo:rl-msg:guarded"`` -> ``("rl-msg", True)``.
-
-    Raises:
-        ZooError: not a zoo strategy, an unknown variant or an unknown suffix.
-    """
-    parts = str(name).strip().split(":")
-    if parts[0].lower() != "zoo" or len(parts) not in (2, 3):
-        raise ZooError(f"{name!r} is not a zoo strategy; expected zoo:<variant> or zoo:<variant>:{GUARDED}")
-    variant = parts[1].lower()
-    if variant not in VARIANT_NAMES:
-        raise ZooError(f"{name!r}: unknown variant {variant!r}; known: {', '.join(VARIANT_NAMES)}")
-    if len(parts) == 3 and parts[2].lower() != GUARDED:
-        raise ZooError(f"{name!r}: unknown suffix {parts[2]!r}; the only one is :{GUARDED} (the entries "
-                       f"behind the return guard)")
-    return variant, len(parts) == 3
-
-
-def strategy_name(variant: str, guard: bool = False) -> str:
-    """The strategy name of an entry: ``zoo:<variant>``, or ``zoo:<variant>:guarded``."""
-    return f"zoo:{variant}" + (f":{GUARDED}" if guard else "")
+    """:func:`patrolsb3.names.parse_strategy`, its error a :class:`ZooError`."""
+    try:
+        return names.parse_strategy(name)
+    except names.StrategyNameError as exc:
+        raise ZooError(str(exc)) from None
 
 
 def variant_folder(map_name: str, variant: str, zoo_dir=None, guard: bool = False) -> Path:

@@ -1,5 +1,6 @@
 """``patrolsb3 claims COMPARE_DIR``: the paper's claims, one row each, with our figure, its 95 %
 interval and a verdict, from a comparison's results (``patrolsb3.claims``)."""
+from ..names import is_learned
 
 
 def add_arguments(parser):
@@ -23,7 +24,7 @@ def run(args):
     if args.guarded:   # the guarded columns stand in for the learned variants; paper-setting ones are left out
         suffix = f":{zoo.GUARDED}"
         figures = {(m, n, name.removesuffix(suffix), metric): f for (m, n, name, metric), f in figures.items()
-                   if name.endswith(suffix) or not name.startswith("zoo:")
+                   if name.endswith(suffix) or not is_learned(name)
                    or not any(k[2] == name + suffix for k in figures)}
     faults = read_faults_result(args.faults_result) if args.faults_result else None
     curves = {m: {v: found for v in zoo.VARIANT_NAMES

@@ -5,6 +5,7 @@ said to be missing otherwise; the entries behind the guard are columns only when
 (``--strategies ...,zoo:rl-msg:guarded``). Heuristic results are kept in
 ``OUT/results.json`` as they finish (``patrolsb3.result_store``): the same command again
 resumes an interrupted comparison or redraws a finished one without running it again."""
+from ..names import is_learned
 
 
 def parse_agents(text: str) -> list[int]:
@@ -146,10 +147,10 @@ def run(args):
         raise ValueError(f"--agents {args.agents}: at most 5 agents (max_agents) per team")
     for name in (args.strategies or "").split(","):
         name = canonical_name(name) if name.strip() else ""
-        if name and not name.startswith("zoo:") and name not in REGISTRY:
+        if name and not is_learned(name) and name not in REGISTRY:
             raise ValueError(f"unknown strategy {name!r}; known: {', '.join(REGISTRY)}, zoo:<variant> "
                              f"or zoo:<variant>:guarded")
-        if name.startswith("zoo:"):
+        if is_learned(name):
             if zoo is None:
                 raise ValueError(f"{name}: patrolsb3.zoo cannot be imported")
             variant, guard = zoo.parse_strategy(name)
@@ -177,7 +178,7 @@ def run(args):
                           f"columns stay empty (the entries behind the return guard: --strategies "
                           f"...,{absent[0]}:guarded)", flush=True)
         cells += [(m, name, n) for name in names for n in sizes]
-    for m, name in dict.fromkeys((m, name) for m, name, _ in cells if name.startswith("zoo:")):
+    for m, name in dict.fromkeys((m, name) for m, name, _ in cells if is_learned(name)):
         variant, guard = zoo.parse_strategy(name)
         if not guard:    # several seeds and no default.yml: one line saying how to choose, before any work
             zoo.default_seed(m, variant)
@@ -185,7 +186,7 @@ def run(args):
     pooled = {}                      # {(MAP, zoo strategy): (seeds pooled, seeds left out)}
     for m, name, n in cells:         # what a zoo entry's eval.json or results.json already holds
         r = None
-        if zoo is not None and name.startswith("zoo:") and not args.rerun_zoo:
+        if zoo is not None and is_learned(name) and not args.rerun_zoo:
             variant, guard = zoo.parse_strategy(name)
             if guard:
                 r = zoo.cached_result(m, variant, n, args.episodes, args.steps, args.seed, args.tests,
@@ -196,7 +197,7 @@ def run(args):
                 if r is not None:
                     pooled[(m.upper(), name)] = (r["training_seeds"], r["unpooled_seeds"])
             sources[(m, name, n)] = "  (from the zoo's eval.json; --rerun-zoo to run it)" if r else ""
-        if r is None and not args.rerun and not name.startswith("zoo:"):
+        if r is None and not args.rerun and not is_learned(name):
             spec, cfg = evaluation_setup(m, n, args.episodes, args.tests, args.steps)
             r = store.find(request_of(name, spec, n, args.episodes, args.tests, args.steps,
                                       args.seed, cfg, deterministic=not args.stochastic))
@@ -216,17 +217,17 @@ def run(args):
     else:
         finished = ((cell, *timed(evaluate, progress=not args.no_progress, **job)) for cell, job in zip(missing, jobs))
     for (m, name, n), r, seconds in finished:   # each stored as soon as it is done
-        if not name.startswith("zoo:"):
+        if not is_learned(name):
             store.add(r)
         found[(m, name, n)] = r
         report_cell(r, name, n, f"  ({seconds:.1f} s)")
     results = [found[c] for c in cells]
     zoo_notes = {(m.upper(), name): zoo_note(zoo, m, name, reused=bool(sources.get((m, name, n))),
                                              pooled=pooled.get((m.upper(), name)))
-                 for m, name, n in cells if name.startswith("zoo:")}
+                 for m, name, n in cells if is_learned(name)}
     curves = {}              # {MAP: {variant (or variant:guarded): [curve.csv of every seed]}} of the zoo columns
     for m, name, n in cells:
-        if name.startswith("zoo:"):
+        if is_learned(name):
             variant, guard = zoo.parse_strategy(name)
             if found := zoo.seed_curves(m, variant, guard=guard):
                 curves.setdefault(m.upper(), {})[name[4:]] = found
