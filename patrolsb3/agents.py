@@ -133,9 +133,9 @@ def play_episode(env, agent: PettingZooAgent, seed: int | None = None, frames: b
     shots, steps = [], 0
     while env.agents:
         obs, rewards, terms, truncs, infos = env.step(agent.act(obs, infos))
-        if env._last_info is not None and int(env.core_state.t[0]) > steps:   # the simulator stepped
+        if env.last_step_info is not None and int(env.core_state.t[0]) > steps:   # the simulator stepped
             steps = int(env.core_state.t[0])
-            metrics.update(env.core_state, env._last_info)
+            metrics.update(env.core_state, env.last_step_info)
             if frames:
                 shots.append(env.render())
     out = {k: (float(v[0]) if np.ndim(v) else v) for k, v in metrics.result().items()}

@@ -277,6 +277,14 @@ class PatrolParallelEnv(ParallelEnv):
     def close(self):
         self._viewer = None
 
+    @property
+    def last_step_info(self):
+        """What the simulator's last step did (``core.step``'s ``StepInfo`` of this episode, the
+        batch axis of length 1): None before the episode's first move phase; a message phase
+        leaves it as it was (the simulator did not step: ``core_state.t`` says when it did).
+        Metrics read it (``agents.play_episode``)."""
+        return self._last_info
+
     def state_array(self):
         """The core's batched state of this episode (n_envs = 1); heuristics may read it."""
         return self.core_state
