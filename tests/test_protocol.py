@@ -209,3 +209,17 @@ def test_the_simulator_checks_moves_against_the_decision_mask_as_against_the_rul
         with pytest.raises(InvalidActionError) as with_rule:
             check_moves(spec, strict, state, moves)
         assert str(with_mask.value) == str(with_rule.value)
+
+
+def test_the_layout_names_the_symbol_planes_and_the_phase_column():
+    from patrolsb3.core import load_map, make_config
+    from patrolsb3.core.observe import PHASE_INDEX
+    from patrolsb3.core.protocol import ObservationLayout
+    spec = load_map("A")
+    planes = ObservationLayout.of(spec, make_config("A", message_encoding="planes"))
+    H, W = spec.shape
+    assert planes.symbol_columns() == slice(2 * H * W, (2 + 16) * H * W)
+    assert planes.phase_column() == planes.grid_size + PHASE_INDEX
+    scalar = ObservationLayout.of(spec, make_config("A"))
+    cols = scalar.symbol_columns()
+    assert cols.stop - cols.start == 0                              # no planes with scalar messages

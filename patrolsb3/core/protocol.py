@@ -150,6 +150,19 @@ class ObservationLayout:
         return {"grid": flat[..., :g].reshape(batch + tuple(self.grid_shape)),
                 "vector": flat[..., g:g + v], "critic": flat[..., g + v:]}
 
+    def symbol_columns(self) -> slice:
+        """The columns of a flat row that hold the symbol planes (grid channels 2 .. C-1, with
+        ``message_encoding='planes'``): +1 on an agent's own cell for its own symbol, -1 on each
+        other agent's cell for theirs. Empty with 'scalar' messages (C = 2)."""
+        H, W = self.grid_shape[1:]
+        return slice(2 * H * W, self.grid_size)
+
+    def phase_column(self) -> int:
+        """The column of a flat row that says the phase (1 in a move phase): the actor vector's
+        ``PHASE_INDEX``."""
+        from .observe import PHASE_INDEX
+        return self.grid_size + PHASE_INDEX
+
     def to_dict(self) -> dict:
         """Plain dict (policy kwargs, config files)."""
         return {"grid_shape": tuple(self.grid_shape), "vector_size": int(self.vector_size),

@@ -30,7 +30,7 @@ from sb3_contrib.common.recurrent.type_aliases import RNNStates
 from stable_baselines3.common.utils import explained_variance, obs_as_tensor
 from stable_baselines3.common.vec_env import VecEnv
 
-from ..core.observe import PHASE_INDEX
+from ..core.protocol import ObservationLayout
 from .buffers import MaskableRecurrentRolloutBuffer, team_gap
 from .policy import PatrolRecurrentPolicy
 
@@ -115,7 +115,7 @@ class MaskableRecurrentPPO(RecurrentPPO):
         self.signal_coef = None if signal_coef is None else float(signal_coef)
         self.listen_coef = None if listen_coef is None else float(listen_coef)
         super().__init__(*args, **kwargs)
-        if self.listen_coef and self.policy.features_extractor_kwargs["grid_shape"][0] <= 2:
+        if self.listen_coef and self.observation_layout().grid_shape[0] <= 2:
             raise ValueError("listen_coef needs legible messages (env.message_encoding=planes): with "
                              "'scalar' messages the received symbols have no channel of their own")
 
@@ -360,6 +360,13 @@ class MaskableRecurrentPPO(RecurrentPPO):
                       "entropy_loss": entropy_loss.item(), "clip_fraction": clip_fraction,
                       "approx_kl": approx_kl, **terms}
 
+    def observation_layout(self) -> ObservationLayout:
+        """Where each part of an observation row sits (the policy's grid, vector and critic
+        sizes): the algorithm reads rows through it, not by hand."""
+        kw = self.policy.features_extractor_kwargs
+        return ObservationLayout(tuple(kw["grid_shape"]), int(kw["vector_size"]), int(kw["critic_size"]),
+                                 int(kw["critic_size"]) // 3)
+
     def signalling(self, distribution, action_masks: th.Tensor, mask: th.Tensor) -> th.Tensor:
         """The positive-signalling term of a minibatch: H(mean symbol distribution) - mean H(symbol
         distribution of a row), over the real rows whose message head has a choice (0 if none).
@@ -387,20 +394,21 @@ class MaskableRecurrentPPO(RecurrentPPO):
         A row listens when it is real, in a move phase, has received a symbol (a -1 on one of
         the others' symbol planes) and has more than one legal move.
         """
-        C, H, W = self.policy.features_extractor_kwargs["grid_shape"]
+        layout = self.observation_layout()
+        symbols = layout.symbol_columns()
         obs = data.observations
-        planes = obs[:, 2 * H * W:C * H * W]                                       # (n, n_symbols*H*W)
+        planes = obs[:, symbols]                                                   # (n, n_symbols*H*W)
         n_messages = int(self.action_space.nvec[0])
         received = (planes < 0).any(dim=1)
         choice = data.action_masks[:, n_messages:].sum(dim=1) > 1
-        move_phase = obs[:, C * H * W + PHASE_INDEX] > 0.5
+        move_phase = obs[:, layout.phase_column()] > 0.5
         rows = mask & received & choice & move_phase                               # (n,)
         if not bool(rows.any()):
             return obs.new_zeros(())
         # read before the second pass: SB3's policy keeps one distribution object and refills it
         heard = distribution.distributions[1].probs[rows]                          # (k, 5)
         silent = obs.clone()
-        silent[:, 2 * H * W:C * H * W] = planes.clamp_min(0.0)                     # own symbol kept
+        silent[:, symbols] = planes.clamp_min(0.0)                                 # own symbol kept
         with th.no_grad():
             unheard, _ = self.policy.get_distribution(silent, data.lstm_states.pi, data.episode_starts,
                                                       data.action_masks)
