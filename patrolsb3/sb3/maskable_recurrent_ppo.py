@@ -20,7 +20,7 @@ deployed rows of each rollout split into that many minibatches.
 from __future__ import annotations
 
 from copy import deepcopy
-from typing import ClassVar
+from typing import ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 import torch as th
@@ -35,11 +35,28 @@ from .buffers import MaskableRecurrentRolloutBuffer, team_gap
 from .policy import PatrolRecurrentPolicy
 
 
+@runtime_checkable
+class PatrolRows(Protocol):
+    """What MaskableRecurrentPPO asks of its vec env beyond SB3's ``VecEnv`` (our
+    :func:`patrolsb3.sb3.make_vec_env` has all three). ``action_masks`` is required (or
+    sb3-contrib's ``env_method("action_masks")``); without ``deployed_rows`` every row is
+    deployed; ``episode_of_rows`` is needed only with ``message_team_share``."""
+
+    def action_masks(self) -> np.ndarray:
+        """(num_envs, sum(nvec)) bool legal actions of every row."""
+
+    def deployed_rows(self) -> np.ndarray:
+        """(num_envs,) bool rows of deployed agents (a smaller team's padded slots are False)."""
+
+    def episode_of_rows(self) -> np.ndarray:
+        """(num_envs,) int the parallel episode of every row."""
+
+
 def env_deployed_rows(env: VecEnv) -> np.ndarray:
-    """(num_envs,) bool rows the policy acts for: the vec env's ``deployed_rows()``, else all."""
-    method = getattr(env, "deployed_rows", None)
-    if callable(method):
-        return np.asarray(method(), dtype=bool)
+    """(num_envs,) bool rows the policy acts for: the vec env's ``deployed_rows()``
+    (:class:`PatrolRows`), else all."""
+    if isinstance(env, PatrolRows) or callable(getattr(env, "deployed_rows", None)):
+        return np.asarray(env.deployed_rows(), dtype=bool)
     return np.ones(env.num_envs, dtype=bool)
 
 
