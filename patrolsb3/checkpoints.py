@@ -12,6 +12,11 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import yaml
+
+from . import zoo
+from .evaluate import run_episodes
+from .runs import write_atomically
 
 
 def run_checkpoints(run_dir) -> list[Path]:
@@ -53,8 +58,7 @@ def validate(path, team_sizes=(1, 3, 5), episodes: int = 4, steps: int = 3000, s
         episode), "bf_rate" (share of episodes with one), "avg_idleness" (AVG^h over every
         episode, failed ones included), "swap_battery" (mean battery fraction at a swap)}.
     """
-    from .zoo import load_checkpoint
-    policy = load_checkpoint(path)
+    policy = zoo.load_checkpoint(path)
     return {"checkpoint": str(path), "timesteps": policy.info["timesteps"],
             **validate_policy(policy, team_sizes, episodes, steps, seed)}
 
@@ -62,9 +66,7 @@ def validate(path, team_sizes=(1, 3, 5), episodes: int = 4, steps: int = 3000, s
 def validate_policy(policy, team_sizes=(1, 3, 5), episodes: int = 4, steps: int = 3000, seed: int = 7) -> dict:
     """The figures of :func:`validate` for a loaded :class:`~patrolsb3.zoo.ZooPolicy` (a
     checkpoint or a zoo entry): {"failures", "bf_rate", "avg_idleness", "swap_battery"}."""
-    from .evaluate import run_episodes
-    from .zoo import evaluation_config
-    cfg = evaluation_config(policy, steps)
+    cfg = zoo.evaluation_config(policy, steps)
     team = np.repeat(np.asarray(team_sizes, dtype=np.int64), episodes)          # (E,)
     result = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, deterministic=True)
     swap = result["swap_battery"]
@@ -76,3 +78,35 @@ def validate_policy(policy, team_sizes=(1, 3, 5), episodes: int = 4, steps: int 
 def rank(rows: list[dict]) -> list[dict]:
     """Best first: fewest battery failures per episode, then the lowest AVG^h."""
     return sorted(rows, key=lambda r: (round(r["failures"], 6), r["avg_idleness"]))
+
+
+def choose_default(map_name: str, variant: str, zoo_dir=None, team_sizes=(1, 3, 5), episodes: int = 4,
+                   steps: int = 3000, seed: int = 7) -> dict:
+    """Pick the paper-setting entry's default seed by validation and write its ``default.yml``.
+
+    Each seed's model plays the greedy validation protocol of ``zoo validate`` (its own
+    simulator seed, not the evaluation's 0, so the choice does not peek at the reported
+    figures); the best by :func:`patrolsb3.checkpoints.rank` (fewest battery failures, then
+    the lowest AVG^h) becomes the default.
+
+    Returns:
+        What was written: {"seed", "chosen_by", "validation": [one row per seed]}.
+
+    Raises:
+        ZooError: the entry has no seed.
+    """
+    folder = zoo.variant_folder(map_name, variant, zoo_dir)
+    have = zoo.seeds(map_name, variant, zoo_dir)
+    if not have:
+        raise zoo.ZooError(f"{folder}: no seed<k>/model.zip to choose from")
+    rows = [{"seed": k, **validate_policy(zoo.load_entry(folder / f"seed{k}"), team_sizes, episodes, steps, seed)}
+            for k in have]
+    best = rank(rows)[0]
+    chosen = {"seed": best["seed"],
+              "chosen_by": (f"zoo choose: greedy validation (simulator seed {seed}, {episodes} episodes x "
+                            f"{steps} steps for n = {','.join(map(str, team_sizes))}): fewest battery "
+                            f"failures, then the lowest AVG^h"),
+              "validation": [{k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()} for r in rows]}
+    text = yaml.safe_dump(chosen, sort_keys=False)
+    write_atomically(folder / zoo.DEFAULT_FILE, lambda partial: partial.write_text(text))
+    return chosen

@@ -74,12 +74,15 @@ def _cause(error) -> str:
     return lines[-1] if lines else type(cause).__name__
 
 
-def sweep_on_ray(trials, cpus_per_trial: int = 1, storage: Path | None = None,
+def sweep_on_ray(trials, run_trial: Callable, cpus_per_trial: int = 1, storage: Path | None = None,
                  say: Callable[[str], None] = print) -> dict:
-    """Run trials as Ray Tune trials (Ray must be connected: :func:`connect`).
+    """Run trials as Ray Tune trials (Ray must be connected: :func:`connect`). This module knows
+    nothing of what a trial is: the caller gives the function that runs one.
 
     Args:
-        trials: the :class:`patrolsb3.sweeps.Trial` to run.
+        trials: the trials to run (``patrolsb3.sweeps.Trial``: a ``name``, a ``timesteps``).
+        run_trial: ``run_trial(trial, torch_threads=k) -> {"timesteps", "seconds"}``
+            (``patrolsb3.sweeps.run_trial``).
         cpus_per_trial: CPUs Tune reserves per trial; also its torch threads.
         storage: where Tune keeps its own record (results, error files); default
             ``<run folders' root>/.tune``.
@@ -91,7 +94,6 @@ def sweep_on_ray(trials, cpus_per_trial: int = 1, storage: Path | None = None,
     require_ray()
     from ray import tune
 
-    from .sweeps import run_trial
     trials = list(trials)
     if not trials:
         return {}

@@ -14,12 +14,12 @@ recharge averages over every swap of the test. The summary is mean and std over 
 """
 from __future__ import annotations
 
-import importlib
 import warnings
 from pathlib import Path
 
 import numpy as np
 
+from . import zoo
 from .names import is_learned
 from .core.config import make_config
 from .core.maps import load_map
@@ -74,10 +74,6 @@ def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0, device: str 
         ValueError: unknown strategy, or a zoo strategy when no zoo module or model exists.
     """
     if is_learned(name):
-        try:
-            zoo = importlib.import_module("patrolsb3.zoo")
-        except ImportError as exc:
-            raise ValueError(f"strategy {name!r} needs patrolsb3.zoo, which cannot be imported: {exc}") from exc
         try:
             variant, guard = zoo.parse_strategy(name)
             return zoo.load(spec.name, variant, spec=spec, device=device, guard=guard)
@@ -290,18 +286,17 @@ def write_zoo_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0
         Path of eval.json: {"map", "strategy", "episodes", "tests", "steps", "seed", "deterministic",
         "results": [evaluate()-style dict per team size]}.
     """
-    from .zoo import evaluation_config, load_entry, strategy_name
     folder = Path(folder)
-    policy = load_entry(folder)
+    policy = zoo.load_entry(folder)
     config = policy.info["config"]
     max_agents = policy.cfg.max_agents
-    cfg = evaluation_config(policy, steps)
+    cfg = zoo.evaluation_config(policy, steps)
     per_size = episodes * tests
     team = np.repeat(np.arange(1, max_agents + 1), per_size)                # (max_agents * per_size,)
     per_episode = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, progress=progress,
                                desc=f"zoo {config['map']}/{config['variant']} n=1..{max_agents}",
                                deterministic=deterministic)
-    strategy = strategy_name(config["variant"], guard=policy.cfg.return_guard)
+    strategy = zoo.strategy_name(config["variant"], guard=policy.cfg.return_guard)
     results = []
     for n in range(1, max_agents + 1):
         rows = team == n

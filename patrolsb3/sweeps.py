@@ -302,7 +302,7 @@ def run_sweep(path, out=None, precision: str | None = None, address: str | None 
         require_ray()
         available = connect(address, cpus).get("CPU", 0)
         say(f"ray: {available:.0f} CPUs, {cpus_per_trial} per trial")
-        for name, result in sweep_on_ray(to_run, cpus_per_trial, say=say).items():
+        for name, result in sweep_on_ray(to_run, run_trial, cpus_per_trial, say=say).items():
             outcomes[name] = TrialOutcome(outcomes[name].trial, result["status"], result["seconds"], result["error"])
     return list(outcomes.values())
 

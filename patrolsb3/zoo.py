@@ -148,39 +148,6 @@ def default_seed(map_name: str, variant: str, zoo_dir=None) -> dict | None:
     return {"seed": have[0], "chosen_by": "the only seed"} if have else None
 
 
-def choose_default(map_name: str, variant: str, zoo_dir=None, team_sizes=(1, 3, 5), episodes: int = 4,
-                   steps: int = 3000, seed: int = 7) -> dict:
-    """Pick the paper-setting entry's default seed by validation and write its ``default.yml``.
-
-    Each seed's model plays the greedy validation protocol of ``zoo validate`` (its own
-    simulator seed, not the evaluation's 0, so the choice does not peek at the reported
-    figures); the best by :func:`patrolsb3.checkpoints.rank` (fewest battery failures, then
-    the lowest AVG^h) becomes the default.
-
-    Returns:
-        What was written: {"seed", "chosen_by", "validation": [one row per seed]}.
-
-    Raises:
-        ZooError: the entry has no seed.
-    """
-    from .checkpoints import rank, validate_policy
-    folder = variant_folder(map_name, variant, zoo_dir)
-    have = seeds(map_name, variant, zoo_dir)
-    if not have:
-        raise ZooError(f"{folder}: no seed<k>/model.zip to choose from")
-    rows = [{"seed": k, **validate_policy(load_entry(folder / f"seed{k}"), team_sizes, episodes, steps, seed)}
-            for k in have]
-    best = rank(rows)[0]
-    chosen = {"seed": best["seed"],
-              "chosen_by": (f"zoo choose: greedy validation (simulator seed {seed}, {episodes} episodes x "
-                            f"{steps} steps for n = {','.join(map(str, team_sizes))}): fewest battery "
-                            f"failures, then the lowest AVG^h"),
-              "validation": [{k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()} for r in rows]}
-    text = yaml.safe_dump(chosen, sort_keys=False)
-    write_atomically(folder / DEFAULT_FILE, lambda partial: partial.write_text(text))
-    return chosen
-
-
 def entry_dir(map_name: str, variant: str, zoo_dir=None, seed: int | None = None, guard: bool = False) -> Path:
     """Folder of one zoo entry (it need not exist).
 

@@ -198,7 +198,7 @@ def run(args):
         print(json.dumps(entry, indent=2, default=str))
         return 0
     if args.zoo_command == "choose":
-        from ..zoo import choose_default
+        from ..checkpoints import choose_default
         for name in ("episodes", "steps"):
             if getattr(args, name) < 1:
                 raise ValueError(f"--{name} must be >= 1, got {getattr(args, name)}")
