@@ -305,11 +305,10 @@ def zoo_tables(results_csv, strategies=("zoo:rl-msg", "zoo:rl-no-msg", "zoo:rl-i
     comparison's ``results.csv``: rows (n, strategy), columns :data:`ZOO_TABLE_METRICS`.
     "(all)" averages over every episode, "(no BF)" over episodes without a battery failure
     (the paper's convention; empty when every episode had one)."""
-    with open(results_csv, newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    value = {(r["map"], int(r["n"]), r["strategy"], r["metric"]): float(r["mean"]) for r in rows}
+    from .claims import read_figures                           # the one reader of results.csv
+    value = {key: figure.mean for key, figure in read_figures(results_csv).items()}
     out = []
-    for m in sorted({r["map"] for r in rows}):
+    for m in sorted({k[0] for k in value}):
         present = [s for s in strategies if any(k[0] == m and k[2] == s for k in value)]
         ns = sorted({k[1] for k in value if k[0] == m})
         out += [f"### Map {m}", "", "| n | strategy | " + " | ".join(h for _, h, _ in ZOO_TABLE_METRICS) + " |",
@@ -333,20 +332,17 @@ def curve_summary(curve_csv, fraction: float = 0.25) -> dict:
     Raises:
         ValueError: a curve without episodes (names the file).
     """
-    with open(curve_csv, newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    if not rows:
+    from .runs import read_curve
+    columns = read_curve(curve_csv)                           # {column: (N,) float}
+    if not columns:
         raise ValueError(f"{curve_csv}: no finished training episode yet")
-    k = max(1, round(len(rows) * fraction))
-
-    def mean(part, key, cast=float):
-        return sum(cast(r[key]) for r in part) / len(part)
-
-    out = {"timesteps": int(rows[-1]["timesteps"]), "episodes": len(rows)}
-    for label, part in (("first", rows[:k]), ("last", rows[-k:])):
-        out[f"reward_{label}"] = mean(part, "reward")
-        out[f"bf_{label}"] = mean(part, "battery_failures", lambda v: float(int(v) > 0))
-        out[f"idleness_{label}"] = mean(part, "mean_idleness")
+    n = len(columns["timesteps"])
+    k = max(1, round(n * fraction))
+    out = {"timesteps": int(columns["timesteps"][-1]), "episodes": n}
+    for label, part in (("first", slice(0, k)), ("last", slice(n - k, n))):
+        out[f"reward_{label}"] = float(columns["reward"][part].mean())
+        out[f"bf_{label}"] = float((columns["battery_failures"][part] > 0).mean())
+        out[f"idleness_{label}"] = float(columns["mean_idleness"][part].mean())
     return out
 
 

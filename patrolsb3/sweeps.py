@@ -310,18 +310,13 @@ def run_sweep(path, out=None, precision: str | None = None, address: str | None 
 def last_figures(trial: Trial, episodes: int = 20) -> dict:
     """The mean of the last ``episodes`` rows of the trial's curve.csv: reward, mean and max
     idleness, battery failures ({} without a curve)."""
-    import csv
-
-    from .runs import RunFolder
+    from .runs import RunFolder, read_curve
     path = RunFolder(trial.run_dir).curve_file
-    if not path.is_file():
-        return {}
-    with path.open(newline="") as f:
-        rows = list(csv.DictReader(f))[-episodes:]
-    if not rows:
+    columns = read_curve(path) if path.is_file() else {}
+    if not columns:
         return {}
     keys = ("reward", "mean_idleness", "max_idleness", "battery_failures")
-    return {k: sum(float(r[k]) for r in rows) / len(rows) for k in keys}
+    return {k: float(columns[k][-episodes:].mean()) for k in keys}
 
 
 def summary_table(outcomes: list[TrialOutcome]) -> str:
