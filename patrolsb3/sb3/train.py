@@ -680,7 +680,7 @@ def _build_model(spec_map, variant: str, spec, hp: dict, seed: int, start_teams,
     if hp.get("normalize_reward", False):
         vec_env = normalized_rewards(vec_env, checkpoint, per_phase(hp["gamma"], vec_env.phases_per_step))
     if checkpoint is not None:
-        model = cls.load(checkpoint, env=vec_env, device=device, tensorboard_log=str(run.tensorboard_dir),
+        model = cls.load(checkpoint, env=vec_env, device=device, tensorboard_log=recorded_path(run.tensorboard_dir),
                          verbose=verbose)
         model._last_obs = None  # the saved observation belongs to the old env: learn() resets
         if verbose:
@@ -688,7 +688,7 @@ def _build_model(spec_map, variant: str, spec, hp: dict, seed: int, start_teams,
         return model, vec_env
     kwargs = algorithm_kwargs(hp, spec, vec_env.layout, vec_env.phases_per_step, rows,
                               episode_steps=config["env"]["episode_steps"])
-    model = cls(policy_cls, vec_env, tensorboard_log=str(run.tensorboard_dir), seed=seed, verbose=verbose,
+    model = cls(policy_cls, vec_env, tensorboard_log=recorded_path(run.tensorboard_dir), seed=seed, verbose=verbose,
                 device=device, **kwargs)
     if warm_weights is not None:
         try:
