@@ -112,3 +112,15 @@ def test_evaluate_and_compare_take_a_zoo_dir(tmp_path, capsys, monkeypatch):
                      "--zoo-dir", str(tmp_path / "zoo"), "--no-progress"]) == 2     # an empty zoo: no entry
     assert os.environ[ZOO_ENV] == str((tmp_path / "zoo").resolve())
     assert "zoo" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", [["evaluate", "--strategy", "CR", "--episodes", "1", "--steps", "5", "--json"],
+                                     ["render", "--strategy", "CR", "--steps", "5", "--out"]])
+def test_an_output_that_is_an_input_is_refused(command, tmp_path, capsys):
+    from pathlib import Path
+    map_file = tmp_path / "mine.txt"
+    text = (Path(__file__).resolve().parents[1] / "maps" / "map_a.txt").read_text()
+    map_file.write_text(text)
+    assert cli.main(command[:1] + ["--map", str(map_file)] + command[1:] + [str(map_file)]) == 2
+    assert "is an input of this command" in capsys.readouterr().err
+    assert map_file.read_text() == text

@@ -24,6 +24,8 @@ def add_arguments(parser):
 
 
 def run(args):
+    from pathlib import Path
+
     from ..evaluate import evaluate, parse_faults
     from ..report import evaluation_text
     from ..outputs import check_output_file, write_json
@@ -33,7 +35,7 @@ def run(args):
         from ..zoo import use_zoo_dir
         use_zoo_dir(args.zoo_dir)
     if args.json:
-        check_output_file(args.json, "--json")
+        check_output_file(args.json, "--json", inputs=[args.map] if Path(args.map).is_file() else [])
     faults = parse_faults(args.faults)
     if sum(k for _, k in faults) > args.agents:
         raise ValueError(f"--faults {' '.join(args.faults)}: {sum(k for _, k in faults)} agents fail in a team of "

@@ -28,9 +28,10 @@ def run(args):
     from ..outputs import check_output_file
     if args.steps < 1 or args.every < 1 or args.tile < 4:
         raise ValueError("--steps and --every must be >= 1 and --tile >= 4")
-    check_output_file(args.out, "--out")
+    map_file = [args.map] if Path(args.map).is_file() else []        # a map file is an input
+    check_output_file(args.out, "--out", inputs=map_file)
     if args.frame:
-        check_output_file(args.frame, "--frame")
+        check_output_file(args.frame, "--frame", inputs=map_file)
     spec = load_map(args.map)
     cfg = make_config(spec.name, episode_steps=max(5000, args.steps))
     state = reset_state(spec, cfg, args.agents, n_envs=1, seed=args.seed)
