@@ -74,3 +74,12 @@ def test_compare_again_reuses_the_heuristics_it_ran(tmp_path, capsys):
     assert (tmp_path / "A-MAX.csv").read_text().splitlines()[1].split(",")[1] == table.splitlines()[1].split(",")[1]
     assert cli.main(args + ["--rerun"]) == 0
     assert "results.json" not in capsys.readouterr().out
+
+
+def test_compare_counts_every_file_it_writes(tmp_path, capsys):
+    out = tmp_path / "c"
+    assert cli.main(["compare", "--maps", "A", "--agents", "1", "--strategies", "CR", "--episodes", "1",
+                     "--steps", "20", "--out", str(out), "--no-progress"]) == 0
+    said = [line for line in capsys.readouterr().out.splitlines() if line.startswith("wrote ")][0]
+    written = [p for p in out.iterdir() if not p.name.startswith(".")]          # lock files aside
+    assert said.startswith(f"wrote {len(written)} files to ")

@@ -233,5 +233,6 @@ def run(args):
                 curves.setdefault(m.upper(), {})[name[4:]] = found
     paths = write_compare(results, args.out, learning_curves=curves, zoo_notes=zoo_notes,
                           faults_result=faults)
+    paths += [store.path] if store.path.is_file() else []     # every result, written as each finished
     print(f"wrote {len(paths)} files to {args.out} (report: {args.out}/report.md)")
     return 0
