@@ -138,7 +138,14 @@ def default_seed(map_name: str, variant: str, zoo_dir=None) -> dict | None:
     folder = variant_folder(map_name, variant, zoo_dir)
     have = seeds(map_name, variant, zoo_dir)
     if (folder / DEFAULT_FILE).is_file():
-        chosen = yaml.safe_load((folder / DEFAULT_FILE).read_text()) or {}
+        try:
+            chosen = yaml.safe_load((folder / DEFAULT_FILE).read_text()) or {}
+        except (yaml.YAMLError, UnicodeDecodeError) as exc:
+            raise ZooError(f"{folder / DEFAULT_FILE}: not valid YAML, cut or damaged ({str(exc).splitlines()[0]}); "
+                           f"write it again with 'patrolsb3 zoo choose {map_name} {variant}'") from None
+        if not isinstance(chosen, dict):
+            raise ZooError(f"{folder / DEFAULT_FILE}: expected a mapping with 'seed', got {type(chosen).__name__}; "
+                           f"write it again with 'patrolsb3 zoo choose {map_name} {variant}'")
         if chosen.get("seed") not in have:
             raise ZooError(f"{folder / DEFAULT_FILE}: names seed {chosen.get('seed')!r}, the entry has {have}")
         return chosen

@@ -124,3 +124,16 @@ def test_an_output_that_is_an_input_is_refused(command, tmp_path, capsys):
     assert cli.main(command[:1] + ["--map", str(map_file)] + command[1:] + [str(map_file)]) == 2
     assert "is an input of this command" in capsys.readouterr().err
     assert map_file.read_text() == text
+
+
+def test_a_damaged_default_yml_of_an_entry_is_named(tiny_zoo, tmp_path, capsys):
+    import shutil
+    zoo_dir = tmp_path / "zoo"
+    shutil.copytree(tiny_zoo, zoo_dir)
+    (zoo_dir / "A" / "rl-msg" / "default.yml").write_text("seed: [0\n")
+    assert cli.main(["zoo", "show", "A", "rl-msg", "--zoo-dir", str(zoo_dir)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "default.yml: not valid YAML, cut or damaged" in err and len(err.splitlines()) == 1
+    (zoo_dir / "A" / "rl-msg" / "default.yml").write_text("- 0\n")
+    assert cli.main(["zoo", "show", "A", "rl-msg", "--zoo-dir", str(zoo_dir)]) == 2
+    assert "expected a mapping with 'seed'" in capsys.readouterr().err
