@@ -305,15 +305,13 @@ class RunFolder:
         Raises:
             RunFolderBusy: another process holds it (one line naming the folder).
         """
-        from filelock import FileLock, Timeout
+        from .outputs import hold
         self.path.mkdir(parents=True, exist_ok=True)
-        lock = FileLock(self.path / self.LOCK)
         try:
-            lock.acquire(timeout=0)
-        except Timeout:
-            raise RunFolderBusy(f"{self.path} is being written by another process (a train, sweep or resume of "
-                                f"the same run); wait for it to end, or use another --run-id") from None
-        return lock
+            return hold(self.path / self.LOCK, f"{self.path} is being written by another process (a train, sweep "
+                                               f"or resume of the same run); wait for it to end, or use another --run-id")
+        except ValueError as exc:
+            raise RunFolderBusy(str(exc)) from None
 
     def create(self) -> None:
         """Make the folder and its checkpoints folder."""

@@ -227,7 +227,8 @@ def run(args):
 
 
 def export_and_evaluate(args) -> int:
-    """``patrolsb3 zoo export``: every argument checked, then the run copied and evaluated
+    """``patrolsb3 zoo export``: every argument checked (the whole numbers by
+    ``patrolsb3.cli.MINIMUMS``), then the run copied and evaluated
     (eval.json, paper metrics, n = 1..5) in a staging folder beside the entry, which replaces
     the entry only once complete: an interrupted or failed export leaves the old entry whole."""
     import os
@@ -235,21 +236,14 @@ def export_and_evaluate(args) -> int:
 
     from ..evaluate import write_zoo_eval
     from ..zoo import ZooError, export, export_destination, replace_entry
-    for name, value, low in (("--episodes", args.episodes, 1), ("--steps", args.steps, 1), ("--seed", args.seed, 0)):
-        if value < low:
-            raise ValueError(f"{name} must be a whole number >= {low}, got {value}")
     if args.cpu_hours is not None and not args.cpu_hours >= 0:
         raise ValueError(f"--cpu-hours must be a number >= 0, got {args.cpu_hours}")
     if args.checkpoint is not None and not os.path.isfile(args.checkpoint):
         raise ValueError(f"--checkpoint {args.checkpoint}: no such file")
-    from filelock import FileLock, Timeout
+    from ..outputs import hold
     entry = export_destination(args.run_dir, zoo_dir=args.zoo_dir, as_seed=args.as_seed)
     entry.parent.mkdir(parents=True, exist_ok=True)
-    lock = FileLock(entry.with_name(f".{entry.name}.lock"))
-    try:
-        lock.acquire(timeout=0)
-    except Timeout:
-        raise ZooError(f"{entry} is being exported by another process; wait for it to end") from None
+    lock = hold(entry.with_name(f".{entry.name}.lock"), f"{entry} is being exported by another process; wait for it to end")
     try:
         if (entry / "model.zip").exists() and not args.overwrite:
             raise ZooError(f"{entry} is an entry already; pass --overwrite to replace it (its model and every "

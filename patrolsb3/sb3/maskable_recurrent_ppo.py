@@ -55,8 +55,9 @@ class PatrolRows(Protocol):
 def env_deployed_rows(env: VecEnv) -> np.ndarray:
     """(num_envs,) bool rows the policy acts for: the vec env's ``deployed_rows()``
     (:class:`PatrolRows`), else all."""
-    if isinstance(env, PatrolRows) or callable(getattr(env, "deployed_rows", None)):
-        return np.asarray(env.deployed_rows(), dtype=bool)
+    method = getattr(env, "deployed_rows", None)           # every rollout step: no Protocol isinstance
+    if callable(method):
+        return np.asarray(method(), dtype=bool)
     return np.ones(env.num_envs, dtype=bool)
 
 
