@@ -305,7 +305,7 @@ class RunFolder:
         Raises:
             RunFolderBusy: another process holds it (one line naming the folder).
         """
-        from .outputs import hold
+        from .locks import hold
         self.path.mkdir(parents=True, exist_ok=True)
         try:
             return hold(self.path / self.LOCK, f"{self.path} is being written by another process (a train, sweep "

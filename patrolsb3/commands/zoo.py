@@ -240,7 +240,7 @@ def export_and_evaluate(args) -> int:
         raise ValueError(f"--cpu-hours must be a number >= 0, got {args.cpu_hours}")
     if args.checkpoint is not None and not os.path.isfile(args.checkpoint):
         raise ValueError(f"--checkpoint {args.checkpoint}: no such file")
-    from ..outputs import hold
+    from ..locks import hold
     entry = export_destination(args.run_dir, zoo_dir=args.zoo_dir, as_seed=args.as_seed)
     entry.parent.mkdir(parents=True, exist_ok=True)
     lock = hold(entry.with_name(f".{entry.name}.lock"), f"{entry} is being exported by another process; wait for it to end")
