@@ -1,3 +1,4 @@
+"""``python -m patrolsb3``: the command line of :mod:`patrolsb3.cli`."""
 import sys
 
 from .cli import main

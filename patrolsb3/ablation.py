@@ -7,7 +7,7 @@ symbols that were sent, attributed to the wrong senders). Each agent's own symbo
 recurrent state are left alone; only what it hears changes, one observer at a time (the move
 phase is run once per observer, as in :mod:`patrolsb3.listening`). The change of AVG^h, MAX^h
 and collisions is reported per episode pair (same seed, same start) with a 95 % bootstrap
-interval of the mean change (:func:`patrolsb3.evaluate.interval95`): an interval that holds 0
+interval of the mean change (:func:`patrolsb3.stats.mean_interval`): an interval that holds 0
 says the messages carry nothing the team's patrol needs.
 """
 from __future__ import annotations
@@ -17,7 +17,10 @@ import dataclasses
 import numpy as np
 
 from .core import protocol
+from .evaluate import run_episodes
 from .listening import with_received_symbols
+from .stats import mean_interval
+from .zoo import evaluation_config
 
 MODES = ("constant", "shuffled")
 CONSTANT_SYMBOL = 1
@@ -103,8 +106,6 @@ def message_ablation(policy, n_agents: int = 3, episodes: int = 10, steps: int =
         "change_ci95"}}, "n_agents", "episodes", "steps", "seed"}; metrics over every episode
         (failed ones included: the ablation must not hide a team that runs dry).
     """
-    from .evaluate import interval95, run_episodes
-    from .zoo import evaluation_config
     if int(n_agents) < 2:
         raise ValueError(f"the message ablation needs a team of at least 2 agents, got n_agents={n_agents}")
     MessageAblation(policy, "constant")                    # the same checks before any work
@@ -118,7 +119,7 @@ def message_ablation(policy, n_agents: int = 3, episodes: int = 10, steps: int =
     for mode in MODES:
         out[mode] = {m: {"mean": float(figures[mode][m].mean()),
                          "change": float((figures[mode][m] - figures[None][m]).mean()),
-                         "change_ci95": interval95(figures[mode][m] - figures[None][m])} for m in METRICS}
+                         "change_ci95": mean_interval(figures[mode][m] - figures[None][m])} for m in METRICS}
     out.update(n_agents=int(n_agents), episodes=int(episodes), steps=int(steps), seed=int(seed))
     return out
 

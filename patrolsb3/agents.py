@@ -28,6 +28,7 @@ import numpy as np
 
 from .core import protocol
 from .core.maps import STAY
+from .core.metrics import EpisodeMetrics
 
 
 class PettingZooAgent:
@@ -91,13 +92,8 @@ class PettingZooAgent:
         rows = np.stack([layout.flatten(observations[a]["grid"], observations[a]["vector"],
                                         observations[a]["critic"]) for a in agents])   # (n, layout.size)
         starts = np.full(len(agents), self.starting)
-        if self.policy.recurrent:
-            actions, self.state = self.policy.policy.predict(rows, state=self.state, episode_start=starts,
-                                                             deterministic=self.deterministic,
-                                                             action_masks=masks)
-        else:
-            actions, _ = self.policy.policy.predict(rows, deterministic=self.deterministic, action_masks=masks)
-        return np.asarray(actions).reshape(len(agents), 2)
+        actions, self.state = self.policy.act_rows(rows, masks, self.state, starts, self.deterministic)
+        return actions
 
     def _heuristic(self, agents: list, masks: np.ndarray, phase: int) -> np.ndarray:
         n = self.env.cfg.n_symbols
@@ -126,7 +122,6 @@ def play_episode(env, agent: PettingZooAgent, seed: int | None = None, frames: b
         battery_failures, swaps, ...), ``steps`` (simulator steps) and, with ``frames``, the
         list ``frames`` of (H_px, W_px, 3) uint8 arrays.
     """
-    from .core.metrics import EpisodeMetrics
     obs, infos = env.reset(seed=seed)
     agent.reset()
     metrics = EpisodeMetrics(1, env.spec_map.n_vertices)

@@ -27,6 +27,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .names import display_name
+from .runs import ComparisonFolder, read_curve
+from .stats import MIN_SEEDS, seed_interval, testable
 
 MSG, NOMSG, INTENTION = "zoo:rl-msg", "zoo:rl-no-msg", "zoo:rl-intention"
 LEARNED = (MSG, NOMSG, INTENTION)
@@ -70,7 +72,7 @@ def read_figures(results_csv) -> dict:
     """
     path = Path(results_csv)
     if path.is_dir():
-        path = path / "results.csv"
+        path = ComparisonFolder(path).results_csv
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no results.csv; run 'patrolsb3 compare ... --out DIR' first")
 
@@ -99,7 +101,6 @@ def read_figures(results_csv) -> dict:
 def _testable(row: dict) -> bool:
     """A results.csv row's cell has the episodes and training seeds to decide (a file written
     before those columns existed: yes, as it was read then)."""
-    from .stats import testable
     episodes = int(row["episodes"]) if (row.get("episodes") or "").strip() else 10 ** 9
     seeds = (row.get("training_seeds") or "").strip()
     return testable(episodes, int(seeds) if seeds else None)
@@ -149,14 +150,17 @@ def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, 
     if beaten_by:            # who wins where
         figure += " (" + "; ".join(f"by {LABEL.get(r, r)} in {len(c)}: {', '.join(c)}" for r, c in beaten_by.items()) + ")"
     figure += f"; level in {level}"
-    if unmeasured:
-        figure += f"; {unmeasured} cells without an interval"
-    if too_few:
-        figure += f"; {too_few} cells too few to test (fewer than 3 training seeds or 10 episodes)"
-    if worst:
-        figure += f" (e.g. {worst})"
+    figure += _untested_and_example(unmeasured, too_few, worst)
     verdict = FAILS if losses else HOLDS if wins == compared else OPEN
     return {"verdict": verdict, "figure": figure, "cells": compared, "unmeasured": unmeasured}
+
+
+def _untested_and_example(unmeasured: int, too_few: int, example: str | None) -> str:
+    """The tail of a claim's figure: the cells without an interval, those below the floor, an example."""
+    tail = f"; {unmeasured} cells without an interval" if unmeasured else ""
+    if too_few:
+        tail += f"; {too_few} cells too few to test (fewer than 3 training seeds or 10 episodes)"
+    return tail + (f" (e.g. {example})" if example else "")
 
 
 def no_worse(figures: dict, who: str, rivals, metric: str, maps=None) -> dict:
@@ -189,12 +193,7 @@ def threshold(figures: dict, who_list, metric: str, limit: float, above: bool, m
     if compared == 0:
         return {"verdict": OPEN, "figure": "not measured (no such cells in this comparison)", "cells": 0}
     figure = f"{held} of {compared} cells clearly {'above' if above else 'at or below'} {limit:g}, {failed} clearly not"
-    if unmeasured:
-        figure += f"; {unmeasured} cells without an interval"
-    if too_few:
-        figure += f"; {too_few} cells too few to test"
-    if example:
-        figure += f" (e.g. {example})"
+    figure += _untested_and_example(unmeasured, too_few, example)
     return {"verdict": FAILS if failed else HOLDS if held == compared else OPEN, "figure": figure,
             "cells": compared}
 
@@ -216,8 +215,6 @@ def training_reward(curves: dict, fraction: float = 0.2) -> dict:
     Args:
         curves: {map: {variant: curve.csv path, or a list of them, one a training seed}}.
     """
-    from .runs import read_curve
-    from .stats import MIN_SEEDS, seed_interval
     figures = {}
     for m, by_variant in curves.items():
         for variant, paths in by_variant.items():

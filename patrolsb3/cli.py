@@ -3,38 +3,40 @@ bench | zoo | sweep | claims``.
 
 Each sub-command lives in its own module ``patrolsb3.commands.<name>`` with two functions,
 ``add_arguments(parser)`` and ``run(args) -> int``; modules import their heavy dependencies
-(torch, SB3) inside ``run`` so that ``patrolsb3 maps`` starts fast.
+(torch, SB3, Ray, pillow) inside ``run`` so that ``patrolsb3 maps`` starts fast.
 """
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
 
+from . import __version__
+from .commands import bench, claims, compare, evaluate, maps, render, sweep, train, zoo
+from .core.maps import MapError
+
 COMMANDS = {
-    "maps": "list the shipped maps, draw them in the terminal or as PNG",
-    "render": "animate a run (random or heuristic) as a GIF",
-    "evaluate": "evaluate one strategy on one map with the paper's metrics",
-    "compare": "run every strategy and write the paper's tables and plots",
-    "train": "train a parameter-shared policy with SB3",
-    "bench": "measure speed: env | evaluate | train",
-    "zoo": "list or inspect the trained checkpoints in zoo/",
-    "sweep": "a grid of training runs as Ray Tune trials (the ray extra), resumable",
-    "claims": "the paper's claims, one row each, tested on a comparison's figures",
+    "maps": (maps, "list the shipped maps, draw them in the terminal or as PNG"),
+    "render": (render, "animate a run (random or heuristic) as a GIF"),
+    "evaluate": (evaluate, "evaluate one strategy on one map with the paper's metrics"),
+    "compare": (compare, "run every strategy and write the paper's tables and plots"),
+    "train": (train, "train a parameter-shared policy with SB3"),
+    "bench": (bench, "measure speed: env | evaluate | train"),
+    "zoo": (zoo, "list or inspect the trained checkpoints in zoo/"),
+    "sweep": (sweep, "a grid of training runs as Ray Tune trials (the ray extra), resumable"),
+    "claims": (claims, "the paper's claims, one row each, tested on a comparison's figures"),
 }
+"""name -> (its module in :mod:`patrolsb3.commands`, its one-line help)."""
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every sub-command registered."""
-    from . import __version__
     parser = argparse.ArgumentParser(
         prog="patrolsb3", description="Multi-agent drone patrolling (the paper's model, heuristics, "
                                       "SB3 training and a model zoo). One sub-command per job; "
                                       "'patrolsb3 COMMAND --help' for its options.")
     parser.add_argument("--version", action="version", version=f"patrolsb3 {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name, help_text in COMMANDS.items():
-        module = importlib.import_module(f"patrolsb3.commands.{name}")
+    for name, (module, help_text) in COMMANDS.items():
         p = sub.add_parser(name, help=help_text, description=help_text)
         module.add_arguments(p)
         p.set_defaults(_module=module)
@@ -62,7 +64,6 @@ def check_minimums(args) -> None:
 
 def main(argv=None) -> int:
     """Entry point of the ``patrolsb3`` console script."""
-    from .core.maps import MapError
     args = build_parser().parse_args(argv)
     try:
         check_minimums(args)

@@ -23,6 +23,8 @@ import time
 from pathlib import Path
 from typing import Callable, Iterator
 
+from .evaluate import evaluate
+
 INSTALL_HINT = 'Ray is not installed; install the extra with: pip install -e ".[ray]"  (or pip install "ray[tune]")'
 
 
@@ -160,7 +162,6 @@ def evaluate_on_ray(jobs: list[dict]) -> Iterator[tuple[int, dict, float]]:
     def evaluate_cell(kwargs: dict):
         import torch
 
-        from .evaluate import evaluate
         torch.set_num_threads(1)
         begun = time.time()
         return evaluate(**kwargs), time.time() - begun

@@ -1,4 +1,5 @@
-"""Run a strategy over batched episodes and summarise the paper's metrics over tests.
+"""Running a strategy's episodes: a heuristic or a zoo model over batched episodes, summarised
+by :mod:`patrolsb3.summary`.
 
 All episodes of one configuration (tests x episodes) step together on the batched core:
 ``policy.predict(sim_state, memory, episode_start)`` -> actions (E, A, 2), then
@@ -7,62 +8,22 @@ with ``invalid_action='raise'``. A heuristic (``patrolsb3.strategies``) and a zo
 (``zoo:<variant>``, loaded by ``patrolsb3.zoo.load(map, variant)``; ``zoo:<variant>:guarded`` for
 the entries behind the return guard) are treated the same way.
 
-Tests: episode e belongs to test ``e // episodes``. Per test, idleness and collision figures
-average over the episodes *without* a battery failure (as in the paper; the count is kept),
-the battery failure rate is the share of episodes with >= 1 failure, and the battery level at
-recharge averages over every swap of the test. The summary is mean and std over tests.
+Tests: episode e belongs to test ``e // episodes`` (:func:`patrolsb3.summary.summarize`).
 """
 from __future__ import annotations
 
-import warnings
-from pathlib import Path
 
 import numpy as np
 
-from . import zoo
-from .names import is_learned
+from . import strategies, zoo
 from .core.config import make_config
 from .core.maps import load_map
 from .core.metrics import EpisodeMetrics, idleness_lower_bounds
 from .core.state import reset_state
 from .core.step import step
-from .stats import interval
+from .names import canonical_name, is_learned
+from .summary import summarize
 
-CLEAN_METRICS = ("avg_idleness", "max_idleness", "worst_idleness", "std_idleness", "collisions")
-"""Averaged over episodes without a battery failure."""
-ALL_METRICS = ("battery_failures", "battery_failure_rate", "swap_battery_pct")
-"""Averaged over every episode (or swap)."""
-
-
-def parse_faults(texts) -> tuple:
-    """Parse ``STEP:K`` strings into ((step, k), ...).
-
-    Raises:
-        ValueError: a string not of the form STEP:K with integers STEP >= 0 and K >= 1.
-    """
-    faults = []
-    for text in texts or ():
-        parts = str(text).split(":")
-        try:
-            if len(parts) != 2:
-                raise ValueError
-            fault_step, k = int(parts[0]), int(parts[1])
-        except ValueError:
-            raise ValueError(f"bad --faults {text!r}: expected STEP:K with integers, e.g. 7200:1 "
-                             f"(K agents fail for good at step STEP)") from None
-        if fault_step < 0 or k < 1:
-            raise ValueError(f"bad --faults {text!r}: STEP must be >= 0 and K >= 1")
-        faults.append((fault_step, k))
-    return tuple(sorted(faults))
-
-
-def canonical_name(name: str) -> str:
-    """The name tables use: heuristics in capitals ('sebs' -> 'SEBS'), zoo models as
-    'zoo:<variant>' (or 'zoo:<variant>:guarded') in lower case."""
-    name = str(name).strip()
-    if is_learned(name):
-        return name.lower()
-    return name.upper()
 
 
 def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0, device: str = "cpu"):
@@ -79,7 +40,6 @@ def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0, device: str 
             return zoo.load(spec.name, variant, spec=spec, device=device, guard=guard)
         except (ValueError, FileNotFoundError) as exc:
             raise ValueError(f"strategy {name!r}: {exc}") from exc
-    from . import strategies
     return strategies.get(name, spec, n_agents, cfg=cfg, seed=seed)
 
 
@@ -123,73 +83,6 @@ def run_episodes(policy, spec, cfg, n_agents: int, n_envs: int, seed: int = 0, p
     return result
 
 
-def interval95(values, resamples: int = 2000) -> list:
-    """95 % bootstrap interval of the mean of per-episode ``values``
-    (:func:`patrolsb3.stats.mean_interval`)."""
-    from .stats import mean_interval
-    return mean_interval(values, resamples)
-
-
-def summarize(per_episode: dict, tests: int) -> dict:
-    """Per-test figures and their mean / std over tests.
-
-    Args:
-        per_episode: output of :func:`run_episodes` (E = tests x episodes).
-        tests: number of tests.
-
-    Returns:
-        dict metric -> {"mean", "std", "tests": [per-test values], "ci95": [low, high],
-        "episodes": [per-episode values]}: std over tests, and a 95 % interval over the episodes
-        themselves (:func:`patrolsb3.stats.interval`: exact for the battery failure rate, the
-        bootstrap of the mean otherwise; the episodes a metric counts,
-        kept so that the seeds of a zoo entry can be pooled: ``patrolsb3.zoo.pooled_result``), plus ``clean_episodes`` (per-test
-        counts of episodes without a battery failure) and ``segments``.
-    """
-    failed = per_episode["failed"].reshape(tests, -1)                        # (T, N)
-    clean = ~failed
-    out = {}
-
-    def stats(values, episodes=None, metric=""):
-        values = np.asarray(values, dtype=np.float64)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            result = {"mean": float(np.nanmean(values)) if np.isfinite(values).any() else float("nan"),
-                      "std": float(np.nanstd(values)) if np.isfinite(values).any() else float("nan"),
-                      "tests": [float(v) for v in values]}
-        if episodes is not None:
-            episodes = np.asarray(episodes, dtype=np.float64)
-            result["ci95"] = interval(metric, episodes)          # exact for a rate
-            result["episodes"] = [float(v) for v in episodes]    # what seeds are pooled from
-        return result
-
-    def clean_mean(x):
-        x = x.reshape(tests, -1)
-        n = clean.sum(axis=1)
-        return np.where(n > 0, np.where(clean, x, 0.0).sum(axis=1) / np.maximum(n, 1), np.nan)
-
-    for name in CLEAN_METRICS:
-        values = np.asarray(per_episode[name], dtype=np.float64)
-        out[name] = stats(clean_mean(values), values[clean.reshape(-1)])
-        # the same over every episode, failed ones included (not in the paper's tables; it
-        # keeps a strategy whose every episode fails from having no idleness figure at all)
-        out[f"{name}_all"] = stats(values.reshape(tests, -1).mean(axis=1), values)
-    out["battery_failures"] = stats(per_episode["battery_failures"].reshape(tests, -1).mean(axis=1),
-                                    per_episode["battery_failures"])
-    out["battery_failure_rate"] = stats(failed.mean(axis=1), failed.reshape(-1).astype(np.float64),
-                                        metric="battery_failure_rate")
-    swaps = per_episode["swaps"].reshape(tests, -1)
-    level = np.nan_to_num(per_episode["swap_battery"]).reshape(tests, -1) * swaps
-    with np.errstate(invalid="ignore", divide="ignore"):
-        out["swap_battery_pct"] = stats(100.0 * level.sum(axis=1) / swaps.sum(axis=1),
-                                        100.0 * np.asarray(per_episode["swap_battery"])[swaps.reshape(-1) > 0])
-    out["clean_episodes"] = [int(n) for n in clean.sum(axis=1)]
-    out["segments"] = [{"start": s["start"], "end": s["end"],
-                        "avg_idleness": stats(clean_mean(s["avg"])),
-                        "max_idleness": stats(clean_mean(s["max"]))}
-                       for s in per_episode.get("segments", [])]
-    return out
-
-
 def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100, tests: int = 1,
              steps: int = 14400, seed: int = 0, faults=(), progress: bool = True, deterministic: bool = True,
              device: str = "cpu", **env) -> dict:
@@ -214,7 +107,7 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
     Returns:
         A JSON-friendly dict: the configuration (``env``: the simulator's, the paper's values for
         the map; for a zoo model also ``policy_settings``, the observation, message and guard
-        settings it acts under, ``ZooPolicy.env_settings``), ``summary`` (see :func:`summarize`)
+        settings it acts under, ``ZooPolicy.env_settings``), ``summary`` (see :func:`patrolsb3.summary.summarize`)
         and ``bounds`` (:func:`idleness_lower_bounds`).
     """
     spec, cfg = evaluation_setup(map_name, n_agents, episodes, tests, steps, faults, **env)
@@ -265,51 +158,3 @@ def evaluation_setup(map_name, n_agents: int, episodes: int, tests: int, steps: 
     return spec, cfg
 
 
-def write_zoo_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0, tests: int = 1,
-               progress: bool = True, deterministic: bool = True) -> Path:
-    """Evaluate a zoo entry for 1..max_agents agents and write ``eval.json`` beside it.
-
-    All team sizes run in one batch (episodes x tests per size) so the policy's forward passes
-    are shared; each size's figures are summarised like ``patrolsb3.evaluate.evaluate`` does,
-    so ``patrolsb3 compare`` can reuse them (:func:`cached_result`).
-
-    Args:
-        folder: the entry folder (``zoo/<map>/<variant>``).
-        episodes: episodes per test and team size.
-        steps: steps per episode (14,400 = the paper's 24 h).
-        seed: simulator seed.
-        tests: tests per team size.
-        progress: progress bar.
-        deterministic: most likely legal actions (True) or sampled ones (False).
-
-    Returns:
-        Path of eval.json: {"map", "strategy", "episodes", "tests", "steps", "seed", "deterministic",
-        "results": [evaluate()-style dict per team size]}.
-    """
-    folder = Path(folder)
-    policy = zoo.load_entry(folder)
-    config = policy.info["config"]
-    max_agents = policy.cfg.max_agents
-    cfg = zoo.evaluation_config(policy, steps)
-    per_size = episodes * tests
-    team = np.repeat(np.arange(1, max_agents + 1), per_size)                # (max_agents * per_size,)
-    per_episode = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, progress=progress,
-                               desc=f"zoo {config['map']}/{config['variant']} n=1..{max_agents}",
-                               deterministic=deterministic)
-    strategy = zoo.strategy_name(config["variant"], guard=policy.cfg.return_guard)
-    results = []
-    for n in range(1, max_agents + 1):
-        rows = team == n
-        part = {k: v[rows] for k, v in per_episode.items() if isinstance(v, np.ndarray)}
-        results.append({"strategy": strategy, "map": config["map"], "n_agents": n, "episodes": episodes,
-                        "tests": tests, "steps": steps, "seed": seed, "faults": [],
-                        "deterministic": bool(deterministic), "env": cfg.to_dict(),
-                        "policy_settings": policy.env_settings(),
-                        "summary": summarize(part, tests),
-                        "bounds": idleness_lower_bounds(policy.spec.n_vertices, n, steps)})
-    out = {"map": config["map"], "strategy": strategy, "episodes": episodes, "tests": tests,
-           "steps": steps, "seed": seed, "deterministic": bool(deterministic),
-           "note": "all team sizes stepped in one batch; episodes of size n are rows n-1 of the batch",
-           "results": results}
-    from .outputs import write_json
-    return write_json(folder / "eval.json", out, indent=2)

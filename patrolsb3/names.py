@@ -68,3 +68,12 @@ def display_name(name: str) -> str:
     variant = base[len(LEARNED_PREFIX):] if is_learned(base) else CSV_COLUMNS.get(base)
     shown = VARIANT_DISPLAY.get(variant, base) if variant else base
     return f"{shown} (guarded)" if guarded else shown
+
+
+def canonical_name(name: str) -> str:
+    """The name tables use: heuristics in capitals ('sebs' -> 'SEBS'), zoo models as
+    'zoo:<variant>' (or 'zoo:<variant>:guarded') in lower case."""
+    name = str(name).strip()
+    if is_learned(name):
+        return name.lower()
+    return name.upper()

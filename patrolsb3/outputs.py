@@ -12,6 +12,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from .runs import ComparisonFolder, RunFolder, ZooEntry, write_atomically
+from .stats import RATE_METRICS, rate_interval
+
 
 def _writable_ancestor(path: Path, argument: str) -> None:
     """The nearest existing ancestor of ``path`` must be a writable folder (the rest is created)."""
@@ -45,7 +48,8 @@ def check_output_file(path, argument: str, inputs=()) -> Path:
     return path
 
 
-INPUT_NAMES = ("results.csv", "results.json", "eval.json", "config.yml", "curve.csv")
+INPUT_NAMES = (ComparisonFolder.RESULTS_CSV, ComparisonFolder.RESULTS_JSON, ZooEntry.EVALUATION, RunFolder.CONFIG,
+               RunFolder.CURVE)
 """Files a command reads out of the folder it is given (a comparison folder, a run or an entry)."""
 
 
@@ -82,7 +86,6 @@ def write_json(path, value, indent: int | None = None) -> Path:
     atomically (:func:`patrolsb3.runs.write_atomically`)."""
     import json
 
-    from .runs import write_atomically
     text = json.dumps(strict_json(value), indent=indent, allow_nan=False)
     return write_atomically(path, lambda partial: partial.write_text(text))
 
@@ -142,7 +145,6 @@ def read_results(results: list) -> list:
 
 
 def _exact_rates(summary: dict) -> dict:
-    from .stats import RATE_METRICS, rate_interval
     for metric in RATE_METRICS:
         figure = summary.get(metric) if isinstance(summary, dict) else None
         if isinstance(figure, dict) and figure.get("episodes"):

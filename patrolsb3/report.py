@@ -16,11 +16,14 @@ from __future__ import annotations
 
 import csv
 import math
-
-import numpy as np
 from pathlib import Path
 
+import numpy as np
+
+from .claims import claims, claims_table, read_figures
+from .learning_curves import plot_learning_curves
 from .names import display_name, is_learned
+from .runs import ComparisonFolder
 
 PAPER_TABLES = {"BF": "battery_failure_rate", "BLv": "swap_battery_pct", "MAX": "max_idleness",
                 "MEAN": "avg_idleness", "COLLISION": "collisions"}
@@ -197,12 +200,11 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
             written.append(png)
             curves = (learning_curves or {}).get(m)
             if curves:
-                from .render import plot_learning_curves
                 png = plot_learning_curves(curves, out / f"{m}-training.png", title=f"map {m}: training")
                 md += [f"### Map {m}: learning curves of the zoo models", "",
                        f"![training on map {m}]({png.name})", ""]
                 written.append(png)
-    long_path = out / "results.csv"
+    long_path = ComparisonFolder(out).results_csv
     with long_path.open("w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(["map", "n", "strategy", "metric", "mean", "std", "ci95_low", "ci95_high",
@@ -218,12 +220,11 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
                                  r["tests"], r["steps"], r.get("deterministic", True), seeds])
     written.append(long_path)
     if any(is_learned(r.get("strategy", "")) for r in results):   # the claims head the report
-        from .claims import claims, claims_table, read_figures
         rows = claims(read_figures(long_path), curves=learning_curves, faults_result=faults_result)
         md[2:2] = ["## The paper's claims on these figures", "",
                    "One row per claim (`patrolsb3 claims`, which says how each verdict is reached).", "",
                    claims_table(rows), ""]
-    report = out / "report.md"
+    report = ComparisonFolder(out).report
     report.write_text("\n".join(md) + "\n")
     written.append(report)
     return written
@@ -305,7 +306,6 @@ def zoo_tables(results_csv, strategies=("zoo:rl-msg", "zoo:rl-no-msg", "zoo:rl-i
     comparison's ``results.csv``: rows (n, strategy), columns :data:`ZOO_TABLE_METRICS`.
     "(all)" averages over every episode, "(no BF)" over episodes without a battery failure
     (the paper's convention; empty when every episode had one)."""
-    from .claims import read_figures                           # the one reader of results.csv
     value = {key: figure.mean for key, figure in read_figures(results_csv).items()}
     out = []
     for m in sorted({k[0] for k in value}):
@@ -322,37 +322,3 @@ def zoo_tables(results_csv, strategies=("zoo:rl-msg", "zoo:rl-no-msg", "zoo:rl-i
                 out.append(f"| {n} | {s} | " + " | ".join(cells) + " |")
         out.append("")
     return "\n".join(out)
-
-
-def curve_summary(curve_csv, fraction: float = 0.25) -> dict:
-    """How a training run went, from its ``curve.csv`` (one row per finished episode): the mean
-    team reward, the share of episodes with a battery failure ("bf") and the mean idleness over
-    the first and the last ``fraction`` of its episodes, the episodes and the last timesteps.
-
-    Raises:
-        ValueError: a curve without episodes (names the file).
-    """
-    from .runs import read_curve
-    columns = read_curve(curve_csv)                           # {column: (N,) float}
-    if not columns:
-        raise ValueError(f"{curve_csv}: no finished training episode yet")
-    n = len(columns["timesteps"])
-    k = max(1, round(n * fraction))
-    out = {"timesteps": int(columns["timesteps"][-1]), "episodes": n}
-    for label, part in (("first", slice(0, k)), ("last", slice(n - k, n))):
-        out[f"reward_{label}"] = float(columns["reward"][part].mean())
-        out[f"bf_{label}"] = float((columns["battery_failures"][part] > 0).mean())
-        out[f"idleness_{label}"] = float(columns["mean_idleness"][part].mean())
-    return out
-
-
-def curve_table(curves: dict) -> str:
-    """Markdown table of :func:`curve_summary` for ``{name: curve.csv path}``."""
-    lines = ["| run | agent-steps | episodes | reward first / last quarter | battery failure share "
-             "first / last | mean idleness first / last |", "|---|---|---|---|---|---|"]
-    for name, path in curves.items():
-        s = curve_summary(path)
-        lines.append(f"| {name} | {s['timesteps']:,} | {s['episodes']} | {s['reward_first']:.0f} / "
-                     f"{s['reward_last']:.0f} | {s['bf_first']:.2f} / {s['bf_last']:.2f} | "
-                     f"{s['idleness_first']:.0f} / {s['idleness_last']:.0f} |")
-    return "\n".join(lines)

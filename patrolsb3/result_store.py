@@ -10,11 +10,11 @@ taken from here (their weights can change under the same name): they come from t
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
-from .names import is_learned
 from .core.config import ENV_VERSION, EnvConfig
+from .names import is_learned
 from .outputs import read_results, write_json
+from .runs import ComparisonFolder
 
 PROTOCOL_KEYS = ("strategy", "map", "n_agents", "episodes", "tests", "steps", "seed", "faults", "env")
 """Result fields that must match for a stored result to stand for a new run."""
@@ -51,7 +51,7 @@ class ResultStore:
     """
 
     def __init__(self, folder):
-        self.path = Path(folder) / "results.json"
+        self.path = ComparisonFolder(folder).results_json
         self.results: list[dict] = []
         if self.path.is_file():
             try:

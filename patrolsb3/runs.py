@@ -1,4 +1,6 @@
-"""The run folder of ``patrolsb3 train``, owned here: its layout, names and files.
+"""The folders the commands write, owned here: their layout, names and files. A training run's
+folder (:class:`RunFolder`), a zoo entry's (:class:`ZooEntry`) and a comparison's
+(:class:`ComparisonFolder`).
 
 Run folder ``<out>/<map>/<variant>/<run_id>/`` (:class:`RunFolder`)::
 
@@ -17,7 +19,13 @@ rename), CSV row blocks included (:func:`append_csv_rows`), so a run killed at a
 leaves each file whole: as it was before the write, or with the whole block. ``--resume`` takes
 the newest *valid* checkpoint (:meth:`RunFolder.newest_checkpoint`) and cuts the three CSV
 files back to it (:meth:`RunFolder.cut_back_to`). ``sb3/train.py``, ``sb3/cpu_time.py``,
-``sb3/callbacks.py``, ``zoo.py`` and ``checkpoints.py`` reach the folder through here only.
+``sb3/callbacks.py`` and the ``zoo`` package reach the folder through here only.
+
+Zoo entry ``zoo/<MAP>/<variant>/seed<k>/`` (:class:`ZooEntry`): a run's ``model.zip`` (the
+policy only), ``config.yml``, ``command.txt``, ``curve.csv``, ``cpu_time.csv``, and its
+figures ``eval.json`` (``zoo eval``), ``listening.json`` and ``ablation.json``; the variant
+folder's ``default.yml`` names the default seed. Comparison ``<out>/`` (:class:`ComparisonFolder`):
+``results.json`` (every result, written as each finishes), ``results.csv``, ``report.md``.
 """
 from __future__ import annotations
 
@@ -29,6 +37,8 @@ import zipfile
 from pathlib import Path
 
 import yaml
+
+from .locks import hold
 
 CHECKPOINT_RE = re.compile(r"model_(\d+)_steps\.zip$")
 """A checkpoint's file name: ``checkpoints/model_<agent-steps>_steps.zip`` (SB3's CheckpointCallback)."""
@@ -212,6 +222,11 @@ def model_steps(model_path) -> int | None:
         return None
 
 
+def _in_folder(name: str) -> property:
+    """A read-only path attribute: the folder's file whose name is the class attribute ``name``."""
+    return property(lambda self: self.path / getattr(self, name), doc=f"``<folder>/<{name}>``.")
+
+
 class RunFolder:
     """The files of one training run (layout in the module docstring): their paths, the
     checkpoints, config.yml through :data:`CONFIG_SCHEMA`, the CSV records and their cut back
@@ -249,38 +264,14 @@ class RunFolder:
         return cls(model_path.parent.parent if model_path.parent.name == cls.CHECKPOINTS else model_path.parent)
 
     # -- paths ---------------------------------------------------------------------------------
-    @property
-    def config_file(self) -> Path:
-        return self.path / self.CONFIG
-
-    @property
-    def model_file(self) -> Path:
-        return self.path / self.MODEL
-
-    @property
-    def command_file(self) -> Path:
-        return self.path / self.COMMAND
-
-    @property
-    def curve_file(self) -> Path:
-        return self.path / self.CURVE
-
-    @property
-    def eval_file(self) -> Path:
-        return self.path / self.EVAL
-
-    @property
-    def cpu_time_file(self) -> Path:
-        return self.path / self.CPU_TIME
-
-    @property
-    def checkpoints_dir(self) -> Path:
-        return self.path / self.CHECKPOINTS
-
-    @property
-    def tensorboard_dir(self) -> Path:
-        return self.path / self.TENSORBOARD
-
+    config_file = _in_folder("CONFIG")
+    model_file = _in_folder("MODEL")
+    command_file = _in_folder("COMMAND")
+    curve_file = _in_folder("CURVE")
+    eval_file = _in_folder("EVAL")
+    cpu_time_file = _in_folder("CPU_TIME")
+    checkpoints_dir = _in_folder("CHECKPOINTS")
+    tensorboard_dir = _in_folder("TENSORBOARD")
     def checkpoint_file(self, timesteps: int) -> Path:
         """``checkpoints/model_<timesteps>_steps.zip``."""
         return self.checkpoints_dir / f"model_{int(timesteps)}_steps.zip"
@@ -305,7 +296,6 @@ class RunFolder:
         Raises:
             RunFolderBusy: another process holds it (one line naming the folder).
         """
-        from .locks import hold
         self.path.mkdir(parents=True, exist_ok=True)
         try:
             return hold(self.path / self.LOCK, f"{self.path} is being written by another process (a train, sweep "
@@ -428,3 +418,39 @@ class RunFolder:
         (the checkpoint a resume starts from): the abandoned stretch after it goes."""
         for name in self.RECORDS:
             trim_rows(self.path / name, timesteps)
+
+
+class ZooEntry(RunFolder):
+    """The files of one zoo entry folder (module docstring): a run's names, and its figures.
+
+    Args:
+        path: the entry folder (need not exist yet).
+    """
+
+    EVALUATION, LISTENING, ABLATION = "eval.json", "listening.json", "ablation.json"
+    FIGURES = (EVALUATION, LISTENING, ABLATION)
+    DEFAULT = "default.yml"
+    """In the variant folder above the seeds: ``{seed: k, chosen_by: ...}``."""
+
+    def __repr__(self) -> str:
+        return f"ZooEntry({str(self.path)!r})"
+
+    evaluation_file = _in_folder("EVALUATION")
+    listening_file = _in_folder("LISTENING")
+    ablation_file = _in_folder("ABLATION")
+
+class ComparisonFolder:
+    """The files of a comparison's ``--out`` folder (``patrolsb3 compare``, read by ``claims``).
+
+    Args:
+        path: the folder (need not exist yet).
+    """
+
+    RESULTS_JSON, RESULTS_CSV, REPORT = "results.json", "results.csv", "report.md"
+
+    def __init__(self, path):
+        self.path = Path(path)
+
+    results_json = _in_folder("RESULTS_JSON")
+    results_csv = _in_folder("RESULTS_CSV")
+    report = _in_folder("REPORT")

@@ -36,6 +36,11 @@ from pathlib import Path
 
 import yaml
 
+from .core.maps import MapError, load_map
+from .distributed import connect, require_ray, sweep_on_ray
+from .outputs import check_output_dir
+from .runs import RunFolder, model_steps, read_curve
+
 SWEEP_KEYS = {"out", "timesteps", "recipe", "set", "grid"}
 GRID_KEYS = {"map", "variant", "seed", "set"}
 
@@ -115,7 +120,6 @@ def _nested(dotted: dict) -> dict:
 def _map_folder(map_name: str) -> str:
     """The folder name ``train`` uses for a map (its name: ``A``, or a map file's stem); a map
     that cannot be loaded keeps its text (:func:`check_trial` reports why)."""
-    from .core.maps import MapError, load_map
     try:
         return load_map(map_name).name
     except (MapError, ValueError, OSError):
@@ -192,7 +196,6 @@ def read_sweep(path, out=None, precision: str | None = None) -> list[Trial]:
 def check_trial(trial: Trial) -> str:
     """'' when every setting of the trial is valid, else the one-line reason (what ``train``
     would refuse before any work), so a bad trial fails alone before the sweep starts."""
-    from .core.maps import MapError
     from .sb3.hyperparams import merge
     from .sb3.train import resolve_settings
     try:
@@ -205,7 +208,6 @@ def check_trial(trial: Trial) -> str:
 def trial_state(trial: Trial) -> str:
     """finished (model.zip at its agent-steps), resumable (a valid checkpoint), new (no folder,
     or an empty one) or blocked (a folder with files but nothing to resume: never replaced)."""
-    from .runs import RunFolder, model_steps
     run = RunFolder(trial.run_dir)
     if run.model_file.is_file() and (model_steps(run.model_file) or 0) >= trial.timesteps:
         return "finished"
@@ -225,7 +227,6 @@ def run_trial(trial: Trial, torch_threads: int = 1) -> dict:
     Returns:
         {"timesteps": agent-steps reached, "seconds": wall time of this call}.
     """
-    from .runs import RunFolder, model_steps
     from .sb3.hyperparams import merge
     from .sb3.train import train
     started = time.time()
@@ -270,7 +271,6 @@ def run_sweep(path, out=None, precision: str | None = None, address: str | None 
         ValueError: bad CPU counts, an output folder that cannot be written, or Ray missing
             when trials are to run (one line saying how to install it).
     """
-    from .outputs import check_output_dir
     if isinstance(cpus_per_trial, bool) or not isinstance(cpus_per_trial, int) or cpus_per_trial < 1:
         raise ValueError(f"cpus_per_trial must be a whole number >= 1, got {cpus_per_trial!r}")
     if cpus is not None and (isinstance(cpus, bool) or not isinstance(cpus, int) or cpus < 1 or address):
@@ -298,7 +298,6 @@ def run_sweep(path, out=None, precision: str | None = None, address: str | None 
     say(f"sweep {path}: {len(trials)} trials, {skipped} finished before, {len(to_run)} to run"
         + (f" ({resuming} resume from a checkpoint)" if to_run else ""))
     if to_run and not dry_run:
-        from .distributed import connect, require_ray, sweep_on_ray
         require_ray()
         available = connect(address, cpus).get("CPU", 0)
         say(f"ray: {available:.0f} CPUs, {cpus_per_trial} per trial")
@@ -310,7 +309,6 @@ def run_sweep(path, out=None, precision: str | None = None, address: str | None 
 def last_figures(trial: Trial, episodes: int = 20) -> dict:
     """The mean of the last ``episodes`` rows of the trial's curve.csv: reward, mean and max
     idleness, battery failures ({} without a curve)."""
-    from .runs import RunFolder, read_curve
     path = RunFolder(trial.run_dir).curve_file
     columns = read_curve(path) if path.is_file() else {}
     if not columns:
@@ -321,7 +319,6 @@ def last_figures(trial: Trial, episodes: int = 20) -> dict:
 
 def summary_table(outcomes: list[TrialOutcome]) -> str:
     """A markdown table: trial, status, final agent-steps, last curve figures, time, error."""
-    from .runs import RunFolder, model_steps
     lines = ["| trial | status | agent-steps | reward | mean idleness | max idleness | battery failures "
              "| seconds | error |", "|---|---|---|---|---|---|---|---|---|"]
     for o in outcomes:

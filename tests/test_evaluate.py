@@ -6,8 +6,10 @@ import numpy as np
 import pytest
 
 from patrolsb3 import cli, zoo
+from patrolsb3.commands.evaluate import parse_faults
 from patrolsb3.core import load_map, make_config
-from patrolsb3.evaluate import evaluate, load_policy, parse_faults, run_episodes, summarize
+from patrolsb3.evaluate import evaluate, load_policy, run_episodes
+from patrolsb3.summary import summarize
 
 
 def test_parse_faults():

@@ -44,7 +44,7 @@ def _damaged_entry(tmp_path):
     run = train(map=str(tmp_path / "room.txt"), timesteps=80, run_dir=tmp_path / "run", hyperparams=hp,
                 progress_bar=False)
     entry = zoo.export(run, zoo_dir=tmp_path / "zoo")
-    from patrolsb3.evaluate import write_zoo_eval
+    from patrolsb3.zoo.evaluation import write_zoo_eval
     text = write_zoo_eval(entry, episodes=1, steps=10, progress=False).read_text()
     (entry / "eval.json").write_text(text[:len(text) // 2])
     return entry

@@ -135,29 +135,3 @@ def test_human_mode_reuses_one_window(monkeypatch):
     assert env._viewer[0] is fig
     assert np.array_equal(image.get_array(), render_frame(env.spec_map, env.cfg, env.core_state))
     plt.close(fig)
-
-
-def test_trailing_mean_by_hand():
-    from patrolsb3.render import trailing_mean
-    np.testing.assert_allclose(trailing_mean([1, 2, 3, 4, 5], 2), [1, 1.5, 2.5, 3.5, 4.5])
-    np.testing.assert_allclose(trailing_mean([4, 0, 2], 50), [4, 2, 2])
-
-
-def test_learning_curve_figure_is_written(tmp_path):
-    from patrolsb3.render import plot_learning_curves, read_curve
-    csv_path = tmp_path / "curve.csv"
-    csv_path.write_text("timesteps,n_agents,reward\n100,1,-5\n200,2,-3\n300,2,-1\n")
-    assert read_curve(csv_path)["reward"].tolist() == [-5, -3, -1]
-    out = plot_learning_curves({"rl-msg": csv_path}, tmp_path / "lc.png", title="A")
-    assert out.stat().st_size > 1000
-
-
-def test_learning_curves_are_drawn_against_simulator_steps():
-    from patrolsb3.render import training_axis
-    # rows as episodes end (not in timesteps order); sim_steps is each episode's length
-    data = {"timesteps": np.array([300.0, 100.0, 200.0]), "reward": np.array([3.0, 1.0, 2.0]),
-            "sim_steps": np.array([30.0, 10.0, 20.0])}
-    order, x, label = training_axis(data)
-    assert order.tolist() == [1, 2, 0] and x.tolist() == [10, 30, 60] and label.startswith("simulator")
-    del data["sim_steps"]
-    assert training_axis(data)[1].tolist() == [100, 200, 300] and training_axis(data)[2] == "agent-steps"

@@ -1,7 +1,6 @@
 """The table writer on hand-made results."""
 import csv
 
-import pytest
 
 from patrolsb3.report import evaluation_text, mean_std, write_compare
 
@@ -19,7 +18,7 @@ def fake(map_name, n, strategy, max_mean, max_std=0.5):
 
 
 def test_intervals_over_episodes_are_shown_and_drawn(tmp_path):
-    from patrolsb3.evaluate import interval95
+    from patrolsb3.stats import mean_interval as interval95
     low, high = interval95([10.0, 12.0, 14.0, 9.0, 15.0, 11.0])
     assert 9.0 < low < 11.8 < high < 15.0
     assert interval95([3.0]) == [3.0, 3.0] and interval95([2.0, 2.0]) == [2.0, 2.0]
@@ -88,25 +87,6 @@ def test_zoo_tables_read_the_comparison(tmp_path):
     assert "### Map A" in text
     assert "| 2 | zoo:rl-msg |  | 321.0 | 1.0 |  |" in text          # no AVG (all); MAX (no BF) nan
     assert "| 2 | CR |  |  | 1.0 | 7.2 |" in text
-
-
-def test_curve_summary_quarters(tmp_path):
-    from patrolsb3.report import curve_summary, curve_table
-    path = tmp_path / "curve.csv"
-    rows = ["timesteps,n_agents,reward,mean_idleness,max_idleness,collisions,battery_failures,sim_steps"]
-    for i in range(8):   # first quarter (2 episodes): failures, last quarter: none
-        rows.append(f"{(i + 1) * 100},1,{-100 + 20 * i},{50 - i},99,0,{1 if i < 3 else 0},500")
-    path.write_text("\n".join(rows) + "\n")
-    s = curve_summary(path)
-    assert s["episodes"] == 8 and s["timesteps"] == 800
-    assert s["bf_first"] == 1.0 and s["bf_last"] == 0.0
-    assert s["reward_first"] == -90.0 and s["reward_last"] == 30.0
-    assert s["idleness_first"] == 49.5 and s["idleness_last"] == 43.5
-    assert "| run1 | 800 | 8 | -90 / 30 | 1.00 / 0.00 | 50 / 44 |" in curve_table({"run1": path})
-    empty = tmp_path / "empty.csv"
-    empty.write_text(rows[0] + "\n")
-    with pytest.raises(ValueError, match="no finished training episode"):
-        curve_summary(empty)
 
 
 def test_clean_figures_say_when_every_episode_had_a_battery_failure():

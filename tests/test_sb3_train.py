@@ -247,7 +247,7 @@ def test_resume_passes_over_empty_and_corrupt_checkpoints(tmp_path, capsys):
     """A run killed while writing a checkpoint leaves an empty or cut file; one with flipped
     bytes fails its CRC: --resume (and zoo export / validate) use the newest valid one, say
     which they passed over, and the writes themselves go through a temporary name."""
-    from patrolsb3.checkpoints import run_checkpoints
+    from patrolsb3.zoo.validation import run_checkpoints
     from patrolsb3.runs import is_valid_model_file
     run = train(map=ROOM, timesteps=800, out=tmp_path, hyperparams=tiny_hp(), progress_bar=False)
     good = RunFolder(run).newest_checkpoint()

@@ -36,7 +36,7 @@ def test_a_stored_rate_is_read_back_with_its_exact_interval():
 
 
 def test_an_evaluation_summarises_its_failure_rate_exactly():
-    from patrolsb3.evaluate import summarize
+    from patrolsb3.summary import summarize
     per_episode = {"failed": np.zeros(20, dtype=bool), "battery_failures": np.zeros(20), "swaps": np.zeros(20),
                    "swap_battery": np.full(20, np.nan),
                    **{k: np.ones(20) for k in ("avg_idleness", "max_idleness", "worst_idleness",

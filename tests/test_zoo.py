@@ -9,6 +9,7 @@ import torch
 import yaml
 
 from patrolsb3 import zoo
+from patrolsb3.commands import zoo as zoo_command
 from patrolsb3.core import load_map, make_config, protocol, reset_state
 from patrolsb3.evaluate import run_episodes
 from patrolsb3.sb3 import make_vec_env
@@ -110,7 +111,7 @@ def test_zoo_policy_runs_strict_episodes_and_writes_eval(trained):
 
 
 def test_write_eval_on_every_team_size(trained):
-    from patrolsb3.evaluate import write_zoo_eval
+    from patrolsb3.zoo.evaluation import write_zoo_eval
     path = write_zoo_eval(trained["folder"], episodes=2, steps=30, progress=False)
     data = json.loads(path.read_text())
     assert [r["n_agents"] for r in data["results"]] == [1, 2, 3, 4, 5]
@@ -332,7 +333,7 @@ def test_zoo_eval_rewrites_eval_json_with_intervals_and_the_card_shows_them(trai
     import shutil
 
     from patrolsb3.cli import main
-    from patrolsb3.zoo_cards import card
+    from patrolsb3.zoo.cards import card
     copy = tmp_path / "zoo"
     shutil.copytree(trained["root"] / "zoo", copy)
     assert main(["zoo", "eval", "ROOM", "rl-msg", "--zoo-dir", str(copy), "--episodes", "3", "--steps", "20"]) == 0
@@ -390,7 +391,7 @@ def test_seeds_are_pooled_episode_by_episode_and_the_unusable_ones_named(tmp_pat
 
 
 def test_cards_gather_each_entrys_listening_and_ablation_into_a_messages_page(trained, tmp_path):
-    from patrolsb3.zoo_cards import write_cards
+    from patrolsb3.zoo.cards import write_cards
     copy = tmp_path / "zoo"
     shutil.copytree(trained["root"] / "zoo", copy)
     entry = copy / "ROOM" / "rl-msg" / "seed0"
@@ -417,7 +418,7 @@ def test_cards_gather_each_entrys_listening_and_ablation_into_a_messages_page(tr
 
 
 def test_a_card_without_message_figures_has_no_messages_section(trained):
-    from patrolsb3.zoo_cards import card
+    from patrolsb3.zoo.cards import card
     entry = zoo.read_entry(trained["folder"])
     assert "What its messages carry" not in card(entry)
 
@@ -426,7 +427,7 @@ def test_the_export_command_refuses_an_existing_entry_and_never_leaves_old_figur
         trained, tmp_path, capsys, monkeypatch):
     import shutil
 
-    from patrolsb3 import cli, evaluate
+    from patrolsb3 import cli
     zoo_dir = tmp_path / "zoo"
     common = ["zoo", "export", str(trained["run"]), "--zoo-dir", str(zoo_dir)]
     assert cli.main(common + ["--episodes", "1", "--steps", "20"]) == 0
@@ -445,7 +446,7 @@ def test_the_export_command_refuses_an_existing_entry_and_never_leaves_old_figur
     # an evaluation that fails half-way (Ctrl-C) leaves the old entry whole, figures included
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
-    monkeypatch.setattr(evaluate, "write_zoo_eval", interrupted)
+    monkeypatch.setattr(zoo_command, "write_zoo_eval", interrupted)
     assert cli.main(common + ["--overwrite", "--episodes", "1", "--steps", "20"]) != 0
     assert "interrupted" in capsys.readouterr().err
     assert (entry / "model.zip").read_bytes() == model and (entry / "listening.json").is_file()

@@ -1,9 +1,10 @@
 """``patrolsb3 bench env|evaluate|train``: print one JSON object of speed figures (medians)."""
-import importlib
 import json
 
-TARGETS = {"env": "patrolsb3.bench.env", "evaluate": "patrolsb3.bench.evaluate",
-           "train": "patrolsb3.bench.train"}
+from ..bench import env, evaluate, train
+
+TARGETS = {"env": env, "evaluate": evaluate, "train": train}
+"""What ``bench`` measures: a module with ``run(repeats, quick, ...) -> dict`` each."""
 
 
 def add_arguments(parser):
@@ -19,7 +20,7 @@ def add_arguments(parser):
 
 
 def run(args):
-    module = importlib.import_module(TARGETS[args.target])
+    module = TARGETS[args.target]
     if args.target == "train":
         from ..sb3.algorithms import torch_device
         from ..sb3.hyperparams import parse_set

@@ -1,6 +1,9 @@
 """``patrolsb3 claims COMPARE_DIR``: the paper's claims, one row each, with our figure, its 95 %
 interval and a verdict, from a comparison's results (``patrolsb3.claims``)."""
+from .. import zoo
+from ..claims import claims, claims_table, read_faults_result, read_figures
 from ..names import is_learned
+from ..outputs import check_output_file, write_json
 
 
 def add_arguments(parser):
@@ -15,9 +18,6 @@ def add_arguments(parser):
 
 
 def run(args):
-    from .. import zoo
-    from ..claims import claims, claims_table, read_faults_result, read_figures
-    from ..outputs import check_output_file, write_json
     if args.json:
         check_output_file(args.json, "--json", inputs=[args.compare_dir] + ([args.faults_result] if args.faults_result else []))
     figures = read_figures(args.compare_dir)

@@ -1,5 +1,32 @@
 """``patrolsb3 evaluate``: one strategy on one map with the paper's metrics (mean +- std over tests)."""
 
+from ..evaluate import evaluate
+from ..outputs import check_output_file, write_json
+from ..report import evaluation_text
+from ..zoo import use_zoo_dir
+
+
+def parse_faults(texts) -> tuple:
+    """Parse ``STEP:K`` strings into ((step, k), ...).
+
+    Raises:
+        ValueError: a string not of the form STEP:K with integers STEP >= 0 and K >= 1.
+    """
+    faults = []
+    for text in texts or ():
+        parts = str(text).split(":")
+        try:
+            if len(parts) != 2:
+                raise ValueError
+            fault_step, k = int(parts[0]), int(parts[1])
+        except ValueError:
+            raise ValueError(f"bad --faults {text!r}: expected STEP:K with integers, e.g. 7200:1 "
+                             f"(K agents fail for good at step STEP)") from None
+        if fault_step < 0 or k < 1:
+            raise ValueError(f"bad --faults {text!r}: STEP must be >= 0 and K >= 1")
+        faults.append((fault_step, k))
+    return tuple(sorted(faults))
+
 
 def add_arguments(parser):
     parser.add_argument("--strategy", required=True,
@@ -26,13 +53,9 @@ def add_arguments(parser):
 def run(args):
     from pathlib import Path
 
-    from ..evaluate import evaluate, parse_faults
-    from ..report import evaluation_text
-    from ..outputs import check_output_file, write_json
     from ..sb3.algorithms import torch_device
     torch_device(args.device)   # a device torch cannot use: one line, before any work
     if args.zoo_dir:
-        from ..zoo import use_zoo_dir
         use_zoo_dir(args.zoo_dir)
     if args.json:
         check_output_file(args.json, "--json", inputs=[args.map] if Path(args.map).is_file() else [])

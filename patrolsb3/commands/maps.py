@@ -1,6 +1,9 @@
 """``patrolsb3 maps [NAME ...] [--png DIR]``: list the shipped maps with their figures, draw
 each one in the terminal (the file legend), and optionally write a PNG picture of each."""
 
+from ..core.maps import available_maps, load_map
+from ..outputs import check_output_dir
+
 
 def add_arguments(parser):
     parser.add_argument("names", nargs="*", metavar="MAP",
@@ -19,8 +22,6 @@ def map_summary(spec) -> dict:
 def run(args):
     from pathlib import Path
 
-    from ..core.maps import available_maps, load_map
-    from ..outputs import check_output_dir
     if args.png:
         check_output_dir(args.png, "--png")
 

@@ -1,6 +1,10 @@
 """``patrolsb3 render --map A --agents 3 --steps 300 --out run.gif [--strategy NAME|zoo:VARIANT] [--seed S]``:
 run one episode of a heuristic on the batched core (n_envs = 1) and write it as a GIF."""
 
+from ..core import load_map, make_config, reset_state, step
+from ..evaluate import load_policy
+from ..outputs import check_output_file
+
 
 def add_arguments(parser):
     parser.add_argument("--map", default="A", help="shipped map name or .txt path (default A)")
@@ -21,11 +25,7 @@ def run(args):
 
     from PIL import Image
 
-    from ..core import load_map, make_config, reset_state, step
-    from ..evaluate import load_policy
     from ..render import render_frame, save_gif
-
-    from ..outputs import check_output_file
     if args.steps < 1 or args.every < 1 or args.tile < 4:
         raise ValueError("--steps and --every must be >= 1 and --tile >= 4")
     map_file = [args.map] if Path(args.map).is_file() else []        # a map file is an input

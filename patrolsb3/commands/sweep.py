@@ -2,6 +2,8 @@
 key) as Ray Tune trials, each a normal run folder; run it again to resume what is unfinished
 (``patrolsb3.sweeps``, ``patrolsb3.distributed``)."""
 
+from ..sweeps import run_sweep, summary_table
+
 
 def add_arguments(parser):
     parser.add_argument("sweep_file", metavar="SWEEP.yml", help="the sweep: grid, timesteps, out (docs/cluster.md)")
@@ -21,7 +23,6 @@ def add_arguments(parser):
 def run(args):
     from functools import partial
 
-    from ..sweeps import run_sweep, summary_table
     outcomes = run_sweep(args.sweep_file, out=args.out, precision=args.precision, address=args.address, cpus=args.cpus,
                          cpus_per_trial=args.cpus_per_trial, dry_run=args.dry_run, say=partial(print, flush=True))
     print(summary_table(outcomes))

@@ -9,6 +9,39 @@ guard, ``--seed-of-entry K`` one training seed."""
 import json
 import math
 
+from ..ablation import ablation_table, message_ablation
+from ..listening import listening
+from ..locks import hold
+from ..outputs import check_output_dir, check_output_file, write_json
+from ..report import clean_figures
+from ..runs import ZooEntry
+from ..zoo import (
+    ZooError,
+    existing_entry_dir,
+    export,
+    export_destination,
+    list_entries,
+    load_entry,
+    read_entry,
+    replace_entry,
+)
+from ..zoo.cards import write_cards
+from ..zoo.evaluation import write_zoo_eval
+from ..zoo.validation import choose_default, rank, run_checkpoints, validate
+
+
+def add_entry_arguments(parser, variant_help: str | None = None) -> None:
+    """The arguments that pick one entry: MAP VARIANT, --zoo-dir, --guarded, --seed-of-entry K."""
+    parser.add_argument("map", help="the map the entry was trained on (A-D)")
+    parser.add_argument("variant", help=variant_help or "rl-msg, rl-no-msg or rl-intention")
+    parser.add_argument("--zoo-dir", default=None, help="another zoo folder (default: $PATROLSB3_ZOO, else the "
+                                                        "checkout's zoo/)")
+    parser.add_argument("--guarded", action="store_true",
+                        help="the entry behind the return guard (zoo/guarded/), not the paper's setting")
+    parser.add_argument("--seed-of-entry", type=int, default=None, dest="entry_seed", metavar="K",
+                        help="the model of training seed K, zoo/MAP/VARIANT/seedK (zoo.load(..., seed=K) in "
+                             "Python; --seed is the simulator's); default: the entry's default seed")
+
 
 def add_action(sub, name: str, help: str):
     """A zoo action whose --help shows its own description (argparse shows ``help`` only in the
@@ -21,13 +54,7 @@ def add_arguments(parser):
     p_list = add_action(sub, "list", help="list every zoo entry")
     p_list.add_argument("--zoo-dir", default=None, help="another zoo folder")
     p_show = add_action(sub, "show", help="print one entry's config and evaluation")
-    p_show.add_argument("map")
-    p_show.add_argument("variant")
-    p_show.add_argument("--zoo-dir", default=None)
-    p_show.add_argument("--guarded", action="store_true",
-                       help="the entry behind the return guard (zoo/guarded/), not the paper's setting")
-    p_show.add_argument("--seed-of-entry", type=int, default=None, dest="entry_seed",
-                       help="one training seed's model (default: the entry's default seed)")
+    add_entry_arguments(p_show)
     p_export = add_action(sub, "export", help="copy a training run into the zoo (policy only) and "
                                              "evaluate it for 1..max_agents agents into eval.json")
     p_export.add_argument("run_dir", help="run folder of 'patrolsb3 train'")
@@ -57,13 +84,7 @@ def add_arguments(parser):
     p_val.add_argument("--last", type=int, default=None, help="only the newest N checkpoints")
     p_eval = add_action(sub, "eval", help="evaluate an entry again and rewrite its eval.json (1..max_agents "
                                           "agents, with 95 %% intervals over episodes)")
-    p_eval.add_argument("map")
-    p_eval.add_argument("variant")
-    p_eval.add_argument("--zoo-dir", default=None)
-    p_eval.add_argument("--guarded", action="store_true",
-                       help="the entry behind the return guard (zoo/guarded/), not the paper's setting")
-    p_eval.add_argument("--seed-of-entry", type=int, default=None, dest="entry_seed",
-                       help="one training seed's model (default: the entry's default seed)")
+    add_entry_arguments(p_eval)
     p_eval.add_argument("--episodes", type=int, default=10, help="episodes per team size (default 10)")
     p_eval.add_argument("--steps", type=int, default=14400, help="steps per episode (default 14400)")
     p_eval.add_argument("--seed", type=int, default=0)
@@ -83,26 +104,14 @@ def add_arguments(parser):
     p_lis = add_action(sub, "listening", help="how much an entry's moves depend on the symbols it receives "
                                              "(KL and greedy change when they are randomised) and how it "
                                              "uses its alphabet")
-    p_lis.add_argument("map")
-    p_lis.add_argument("variant", help="rl-msg or rl-intention")
-    p_lis.add_argument("--zoo-dir", default=None)
-    p_lis.add_argument("--guarded", action="store_true",
-                       help="the entry behind the return guard (zoo/guarded/), not the paper's setting")
-    p_lis.add_argument("--seed-of-entry", type=int, default=None, dest="entry_seed",
-                       help="one training seed's model (default: the entry's default seed)")
+    add_entry_arguments(p_lis, variant_help="rl-msg or rl-intention")
     p_lis.add_argument("--agents", type=int, default=3, help="team size (default 3)")
     p_lis.add_argument("--episodes", type=int, default=8, help="parallel episodes (default 8)")
     p_lis.add_argument("--steps", type=int, default=500, help="simulator steps (default 500)")
     p_lis.add_argument("--seed", type=int, default=1000, help="seed (default 1000; the zoo's eval uses 0)")
     p_abl = add_action(sub, "ablation", help="the entry's AVG^h, MAX^h and collisions when the messages it "
                                             "receives are made constant or shuffled between agents")
-    p_abl.add_argument("map")
-    p_abl.add_argument("variant", help="rl-msg or rl-intention")
-    p_abl.add_argument("--zoo-dir", default=None)
-    p_abl.add_argument("--guarded", action="store_true",
-                       help="the entry behind the return guard (zoo/guarded/), not the paper's setting")
-    p_abl.add_argument("--seed-of-entry", type=int, default=None, dest="entry_seed",
-                       help="one training seed's model (default: the entry's default seed)")
+    add_entry_arguments(p_abl, variant_help="rl-msg or rl-intention")
     p_abl.add_argument("--agents", type=int, default=3, help="team size (default 3)")
     p_abl.add_argument("--episodes", type=int, default=10, help="episodes (default 10)")
     p_abl.add_argument("--steps", type=int, default=2000, help="simulator steps per episode (default 2000)")
@@ -122,7 +131,6 @@ def relative_path(path) -> str:
 
 def headline(entry: dict) -> str:
     """Short text of an entry's evaluation: MAX and AVG idleness, collisions, BF rate per n."""
-    from ..report import clean_figures
     ev = entry.get("eval") or {}
     parts = []
     for row in ev.get("results", []):
@@ -148,38 +156,30 @@ def chosen_entry(args):
     Raises:
         ZooError: no such entry or seed (:func:`patrolsb3.zoo.existing_entry_dir`).
     """
-    from ..zoo import existing_entry_dir
     return existing_entry_dir(args.map, args.variant, args.zoo_dir, seed=args.entry_seed, guard=args.guarded)
 
 
 def run(args):
-    from ..zoo import list_entries, load_entry, read_entry
     if args.zoo_command == "export":
         return export_and_evaluate(args)
     if args.zoo_command == "validate":
         return validate_checkpoints(args)
     if args.zoo_command == "eval":
-        from ..evaluate import write_zoo_eval
         path = write_zoo_eval(chosen_entry(args), episodes=args.episodes,
                               steps=args.steps, seed=args.seed, deterministic=not args.stochastic)
         print(f"evaluation written to {relative_path(path)}")
         return 0
     if args.zoo_command == "cards":
-        from ..outputs import check_output_dir
-        from ..zoo_cards import write_cards
         check_output_dir(args.out, "--out")
         paths = write_cards(args.out, zoo_dir=args.zoo_dir)
         print(f"wrote {len(paths)} files to {args.out}")
         return 0
     if args.zoo_command == "listening":
-        from ..listening import listening
         figures = listening(load_entry(chosen_entry(args)), n_agents=args.agents,
                             episodes=args.episodes, steps=args.steps, seed=args.seed)
         print(json.dumps({"entry": f"{args.map.upper()}/{args.variant}", **figures}))
         return 0
     if args.zoo_command == "ablation":
-        from ..ablation import ablation_table, message_ablation
-        from ..outputs import check_output_file, write_json
         if args.json:
             check_output_file(args.json, "--json")
         for name in ("agents", "episodes", "steps"):
@@ -198,7 +198,6 @@ def run(args):
         print(json.dumps(entry, indent=2, default=str))
         return 0
     if args.zoo_command == "choose":
-        from ..checkpoints import choose_default
         for name in ("episodes", "steps"):
             if getattr(args, name) < 1:
                 raise ValueError(f"--{name} must be >= 1, got {getattr(args, name)}")
@@ -234,18 +233,15 @@ def export_and_evaluate(args) -> int:
     import os
     import shutil
 
-    from ..evaluate import write_zoo_eval
-    from ..zoo import ZooError, export, export_destination, replace_entry
     if args.cpu_hours is not None and not args.cpu_hours >= 0:
         raise ValueError(f"--cpu-hours must be a number >= 0, got {args.cpu_hours}")
     if args.checkpoint is not None and not os.path.isfile(args.checkpoint):
         raise ValueError(f"--checkpoint {args.checkpoint}: no such file")
-    from ..locks import hold
     entry = export_destination(args.run_dir, zoo_dir=args.zoo_dir, as_seed=args.as_seed)
     entry.parent.mkdir(parents=True, exist_ok=True)
     lock = hold(entry.with_name(f".{entry.name}.lock"), f"{entry} is being exported by another process; wait for it to end")
     try:
-        if (entry / "model.zip").exists() and not args.overwrite:
+        if ZooEntry(entry).model_file.exists() and not args.overwrite:
             raise ZooError(f"{entry} is an entry already; pass --overwrite to replace it (its model and every "
                            f"figure of it), or export with another --zoo-dir")
         staged = entry.with_name(f".{entry.name}.export-{os.getpid()}")
@@ -270,7 +266,6 @@ def export_and_evaluate(args) -> int:
 
 def validate_checkpoints(args) -> int:
     """``patrolsb3 zoo validate``: one line per checkpoint, then the best by failures and AVG^h."""
-    from ..checkpoints import rank, run_checkpoints, validate
     sizes = team_sizes(args.agents)
     paths = run_checkpoints(args.run_dir)
     if args.last:

@@ -30,8 +30,7 @@ from .maps import STAY, MapSpec
 from .masks import action_mask, composite_action_mask
 from .observe import PHASE_INDEX, actor_observation, critic_state, draw_positions, grid_channels, vector_size
 from .state import State
-from .step import InvalidActionError, StepInfo
-from .step import step as core_step
+from .step import InvalidActionError, StepInfo, step as core_step
 
 MESSAGE_PHASE, MOVE_PHASE = 0, 1
 PHASE_NAMES = ("message", "move")
@@ -160,7 +159,6 @@ class ObservationLayout:
     def phase_column(self) -> int:
         """The column of a flat row that says the phase (1 in a move phase): the actor vector's
         ``PHASE_INDEX``."""
-        from .observe import PHASE_INDEX
         return self.grid_size + PHASE_INDEX
 
     def to_dict(self) -> dict:

@@ -3,6 +3,9 @@ from __future__ import annotations
 
 import dataclasses
 
+from .maskable_recurrent_ppo import MaskableRecurrentPPO
+from .policy import PatrolMaskablePolicy, PatrolRecurrentPolicy
+
 
 @dataclasses.dataclass(frozen=True)
 class AlgorithmSpec:
@@ -25,8 +28,6 @@ class AlgorithmSpec:
         """(algorithm class, policy class), imported on demand (torch is heavy)."""
         from sb3_contrib import MaskablePPO, RecurrentPPO
 
-        from .maskable_recurrent_ppo import MaskableRecurrentPPO
-        from .policy import PatrolMaskablePolicy, PatrolRecurrentPolicy
         return {"MaskableRecurrentPPO": (MaskableRecurrentPPO, PatrolRecurrentPolicy),
                 "MaskablePPO": (MaskablePPO, PatrolMaskablePolicy),
                 "RecurrentPPO": (RecurrentPPO, PatrolRecurrentPolicy)}[self.name]

@@ -93,6 +93,19 @@ class PatrolFeaturesExtractor(BaseFeaturesExtractor):
         return self.dense(th.cat([self.conv(grid), rest], dim=1))
 
 
+def _policy_kwargs(kwargs: dict, grid_shape, vector_size, critic_size, conv_channels, dense_sizes) -> dict:
+    """SB3 policy keyword arguments for the paper's networks: tanh, no extra layers after the
+    trunks, the actor's and the critic's own :class:`PatrolFeaturesExtractor`."""
+    kwargs = dict(kwargs)
+    kwargs.setdefault("activation_fn", nn.Tanh)
+    kwargs.setdefault("net_arch", dict(pi=[], vf=[]))
+    kwargs["share_features_extractor"] = False
+    kwargs["features_extractor_class"] = PatrolFeaturesExtractor
+    kwargs["features_extractor_kwargs"] = _extractor_kwargs(grid_shape, vector_size, critic_size,
+                                                            conv_channels, dense_sizes)
+    return kwargs
+
+
 def _extractor_kwargs(grid_shape, vector_size, critic_size, conv_channels, dense_sizes) -> dict:
     return dict(grid_shape=tuple(grid_shape), vector_size=int(vector_size), critic_size=int(critic_size),
                 conv_channels=tuple(conv_channels), dense_sizes=tuple(dense_sizes))
@@ -213,12 +226,7 @@ class PatrolRecurrentPolicy(_RoleExtractorMixin, RecurrentActorCriticPolicy):
     def __init__(self, observation_space, action_space, lr_schedule, grid_shape, vector_size: int = 15,
                  critic_size: int = 15, conv_channels=(4, 8), dense_sizes=(512, 341, 227),
                  lstm_hidden_size: int = 128, enable_critic_lstm: bool = False, **kwargs: Any):
-        kwargs.setdefault("activation_fn", nn.Tanh)
-        kwargs.setdefault("net_arch", dict(pi=[], vf=[]))
-        kwargs["share_features_extractor"] = False
-        kwargs["features_extractor_class"] = PatrolFeaturesExtractor
-        kwargs["features_extractor_kwargs"] = _extractor_kwargs(grid_shape, vector_size, critic_size,
-                                                                conv_channels, dense_sizes)
+        kwargs = _policy_kwargs(kwargs, grid_shape, vector_size, critic_size, conv_channels, dense_sizes)
         super().__init__(observation_space, action_space, lr_schedule, lstm_hidden_size=lstm_hidden_size,
                          enable_critic_lstm=enable_critic_lstm, **kwargs)
 
@@ -376,12 +384,7 @@ class PatrolMaskablePolicy(_RoleExtractorMixin, MaskableActorCriticPolicy):
 
     def __init__(self, observation_space, action_space, lr_schedule, grid_shape, vector_size: int = 15,
                  critic_size: int = 15, conv_channels=(4, 8), dense_sizes=(512, 341, 227), **kwargs: Any):
-        kwargs.setdefault("activation_fn", nn.Tanh)
-        kwargs.setdefault("net_arch", dict(pi=[], vf=[]))
-        kwargs["share_features_extractor"] = False
-        kwargs["features_extractor_class"] = PatrolFeaturesExtractor
-        kwargs["features_extractor_kwargs"] = _extractor_kwargs(grid_shape, vector_size, critic_size,
-                                                                conv_channels, dense_sizes)
+        kwargs = _policy_kwargs(kwargs, grid_shape, vector_size, critic_size, conv_channels, dense_sizes)
         super().__init__(observation_space, action_space, lr_schedule, **kwargs)
 
     def extract_features(self, obs, features_extractor=None):

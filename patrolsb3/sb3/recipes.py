@@ -29,6 +29,11 @@ import copy
 from pathlib import Path
 from typing import Any
 
+from ..core.maps import load_map
+from ..runs import RunFolder, model_steps
+from .hyperparams import merge
+from .train import resolve_settings, train
+
 SHARED = {"normalize_reward": True, "gamma": 0.99, "batch_size": 2048,
           "env": {"local_idleness": True, "c_d": 200.0, "message_encoding": "planes"}}
 
@@ -96,10 +101,8 @@ def train_in_stages(map="A", variant: str = "rl-msg", timesteps: int = 10_000_00
     Returns:
         Path: the stage-2 run folder.
     """
-    from .hyperparams import merge
-    from ..runs import RunFolder, model_steps
-    from .train import train
     import sys
+
     say = say or (lambda line: print(line, file=sys.stderr, flush=True))
     run_id = run_id or f"seed{seed}"
     first = max(1, round(int(timesteps) * STAGE1_SHARE))
@@ -109,10 +112,8 @@ def train_in_stages(map="A", variant: str = "rl-msg", timesteps: int = 10_000_00
         hp = merge(recipe(f"zoo-stage{stage}"), overrides or {})
         stages.append((folder, hp))
     (out1, hp1), (out2, hp2) = stages
-    from .train import resolve_settings
     for hp, steps in ((hp1, first), (hp2, int(timesteps))):     # both stages' settings, before any work
         resolve_settings(map, variant, merge(hp, {"timesteps": steps}))
-    from ..core.maps import load_map
     name = load_map(map).name
     run1, run2 = out1 / name / variant / run_id, out2 / name / variant / run_id
     model1 = RunFolder(run1).model_file

@@ -20,13 +20,19 @@ import numpy as np
 from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
 from stable_baselines3.common.vec_env import VecNormalize
 
-from ..core.config import EnvConfig
+from .. import __version__
+from ..core.config import ENV_VERSION, EnvConfig, make_config
+from ..core.maps import is_shipped, load_map, source_label
 from ..runs import RunFolder, is_valid_model_file, model_steps, write_atomically
 from .algorithms import DEFAULT_ALGORITHM, get_algorithm, torch_device
-from .cpu_time import cpu_hours_of
-from .curriculum import CURRICULUM
+from .callbacks import LearningCurveCallback, PaperMetricsEvalCallback
+from .cpu_time import CpuTimeCallback, cpu_hours_of, read_rows, restart_at
+from .curriculum import CURRICULUM, CurriculumCallback
 from .hyperparams import load_hyperparams, merge, per_phase, schedule
+from .policy import policy_kwargs_for
 from .precision import PRECISIONS, resolve_precision
+from .variants import variant_overrides
+from .vec_env import DEFAULT_AGENTS, make_vec_env, training_config
 
 COMMUNICATION_KEYS = ("ent_coef_message", "signal_coef", "listen_coef", "message_team_share")
 """Optional coefficients of MaskableRecurrentPPO for learned messages (None: off)."""
@@ -90,8 +96,6 @@ def versions() -> dict:
     import stable_baselines3
     import torch
 
-    from .. import __version__
-    from ..core.config import ENV_VERSION
     return {"patrolsb3": str(__version__), "env_version": str(ENV_VERSION),
             "stable_baselines3": str(stable_baselines3.__version__),
             "sb3_contrib": str(sb3_contrib.__version__), "torch": str(torch.__version__), "numpy": str(np.__version__)}
@@ -136,7 +140,6 @@ def algorithm_kwargs(hp: dict, spec, layout, phases_per_step: int, rows: int, ep
     Raises:
         ValueError: neither ``batch_size`` nor ``n_minibatches``, or one below 1.
     """
-    from .policy import policy_kwargs_for
     if episode_steps is None:
         episode_steps = (hp.get("env") or {}).get("episode_steps", EnvConfig.episode_steps)
     n_steps = rollout_env_steps(hp["n_steps"], episode_steps, phases_per_step)
@@ -424,7 +427,6 @@ def policy_budget(folder: RunFolder) -> dict:
     ``cpu_time.csv`` ends at the step where the run finished, so its last row, plus the stages
     the run was itself warm-started from, gives the same two figures.
     """
-    from .cpu_time import read_rows
     config = folder.read_config()
     budget = config.get("budget") or {}
     rows = read_rows(folder.path)
@@ -480,7 +482,6 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     """
     import torch
 
-    from ..core.maps import is_shipped, source_label
 
     device = torch_device(device)  # a device torch cannot use: one line, before any work
     shortcuts = {k: v for k, v in dict(n_envs=n_envs, eval_freq=eval_freq, checkpoint_freq=checkpoint_freq,
@@ -574,9 +575,6 @@ def resolve_settings(map, variant: str, hyperparams: dict | None = None, hyperpa
             range (one line naming it).
         MapError: a map file that cannot be read.
     """
-    from ..core.config import make_config
-    from ..core.maps import load_map
-    from .variants import variant_overrides
     spec_map = load_map(map)
     variant_overrides(variant)  # unknown variant -> ValueError listing the known ones
     hp = resolve_hyperparams(spec_map.name, hyperparams_file, hyperparams or {})
@@ -591,7 +589,6 @@ def resolve_settings(map, variant: str, hyperparams: dict | None = None, hyperpa
 def _run_teams(spec_map, variant: str, hp: dict, strict: bool = True):
     """The run's env config (the one its vec env runs: :func:`patrolsb3.sb3.vec_env.training_config`),
     its curriculum of team sizes and the teams it starts with."""
-    from .vec_env import DEFAULT_AGENTS, training_config
     cfg = training_config(spec_map, variant, strict, **dict(hp.get("env") or {}))
     n_par = int(hp.get("n_envs", 8))
     teams = curriculum_teams(n_par, min(cfg.max_agents, spec_map.n_vertices))
@@ -669,7 +666,6 @@ def _build_model(spec_map, variant: str, spec, hp: dict, seed: int, start_teams,
                  config: dict, run: RunFolder, device: str, verbose: int):
     """The training vec env and the model: loaded from ``checkpoint``, or new (from
     ``warm_weights`` if given)."""
-    from .vec_env import make_vec_env
     env_kwargs = dict(hp.get("env") or {})
     cls, policy_cls = spec.classes()
     vec_env = make_vec_env(spec_map, agents=start_teams, variant=variant, seed=seed, strict=spec.masked,
@@ -703,10 +699,6 @@ def _callbacks(spec_map, variant: str, spec, hp: dict, seed: int, teams, total: 
                vec_env, resumed: bool):
     """The run's callbacks (curriculum, CPU time, checkpoints, learning curve, evaluation), and
     the curve and CPU-time ones by name."""
-    from .callbacks import LearningCurveCallback, PaperMetricsEvalCallback
-    from .cpu_time import CpuTimeCallback, restart_at
-    from .curriculum import CurriculumCallback
-    from .vec_env import make_vec_env
     rows = vec_env.num_envs
     max_agents = vec_env.layout.max_agents
     eval_teams = [k for k in range(1, max_agents + 1) if k <= spec_map.n_vertices] * int(hp.get("eval_episodes", 1))

@@ -1,4 +1,5 @@
-"""Choose a training run's checkpoint by a short validation evaluation (``patrolsb3 zoo validate``).
+"""Choosing by validation: a run's checkpoint (``patrolsb3 zoo validate``) and an entry's default
+seed (``patrolsb3 zoo choose``), each by a short greedy evaluation on the validation seed.
 
 PPO's last checkpoint is not always its best: in our staged training the recharge learned in
 one stage can be lost again in the next while the training curve (sampled actions) still looks
@@ -14,9 +15,10 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from . import zoo
-from .evaluate import run_episodes
-from .runs import write_atomically
+from ..evaluate import run_episodes
+from ..runs import RunFolder, is_valid_model_file, model_steps, write_atomically
+from .folders import DEFAULT_FILE, ZooError, seeds, variant_folder
+from .policy import evaluation_config, load_checkpoint, load_entry
 
 
 def run_checkpoints(run_dir) -> list[Path]:
@@ -27,7 +29,6 @@ def run_checkpoints(run_dir) -> list[Path]:
     Raises:
         FileNotFoundError: a folder with no checkpoint and no model.zip.
     """
-    from .runs import RunFolder, is_valid_model_file, model_steps
     run = RunFolder(run_dir)
     paths = []
     for path in run.checkpoints():
@@ -58,7 +59,7 @@ def validate(path, team_sizes=(1, 3, 5), episodes: int = 4, steps: int = 3000, s
         episode), "bf_rate" (share of episodes with one), "avg_idleness" (AVG^h over every
         episode, failed ones included), "swap_battery" (mean battery fraction at a swap)}.
     """
-    policy = zoo.load_checkpoint(path)
+    policy = load_checkpoint(path)
     return {"checkpoint": str(path), "timesteps": policy.info["timesteps"],
             **validate_policy(policy, team_sizes, episodes, steps, seed)}
 
@@ -66,7 +67,7 @@ def validate(path, team_sizes=(1, 3, 5), episodes: int = 4, steps: int = 3000, s
 def validate_policy(policy, team_sizes=(1, 3, 5), episodes: int = 4, steps: int = 3000, seed: int = 7) -> dict:
     """The figures of :func:`validate` for a loaded :class:`~patrolsb3.zoo.ZooPolicy` (a
     checkpoint or a zoo entry): {"failures", "bf_rate", "avg_idleness", "swap_battery"}."""
-    cfg = zoo.evaluation_config(policy, steps)
+    cfg = evaluation_config(policy, steps)
     team = np.repeat(np.asarray(team_sizes, dtype=np.int64), episodes)          # (E,)
     result = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, deterministic=True)
     swap = result["swap_battery"]
@@ -86,7 +87,7 @@ def choose_default(map_name: str, variant: str, zoo_dir=None, team_sizes=(1, 3, 
 
     Each seed's model plays the greedy validation protocol of ``zoo validate`` (its own
     simulator seed, not the evaluation's 0, so the choice does not peek at the reported
-    figures); the best by :func:`patrolsb3.checkpoints.rank` (fewest battery failures, then
+    figures); the best by :func:`patrolsb3.zoo.validation.rank` (fewest battery failures, then
     the lowest AVG^h) becomes the default.
 
     Returns:
@@ -95,11 +96,11 @@ def choose_default(map_name: str, variant: str, zoo_dir=None, team_sizes=(1, 3, 
     Raises:
         ZooError: the entry has no seed.
     """
-    folder = zoo.variant_folder(map_name, variant, zoo_dir)
-    have = zoo.seeds(map_name, variant, zoo_dir)
+    folder = variant_folder(map_name, variant, zoo_dir)
+    have = seeds(map_name, variant, zoo_dir)
     if not have:
-        raise zoo.ZooError(f"{folder}: no seed<k>/model.zip to choose from")
-    rows = [{"seed": k, **validate_policy(zoo.load_entry(folder / f"seed{k}"), team_sizes, episodes, steps, seed)}
+        raise ZooError(f"{folder}: no seed<k>/model.zip to choose from")
+    rows = [{"seed": k, **validate_policy(load_entry(folder / f"seed{k}"), team_sizes, episodes, steps, seed)}
             for k in have]
     best = rank(rows)[0]
     chosen = {"seed": best["seed"],
@@ -108,5 +109,5 @@ def choose_default(map_name: str, variant: str, zoo_dir=None, team_sizes=(1, 3, 
                             f"failures, then the lowest AVG^h"),
               "validation": [{k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()} for r in rows]}
     text = yaml.safe_dump(chosen, sort_keys=False)
-    write_atomically(folder / zoo.DEFAULT_FILE, lambda partial: partial.write_text(text))
+    write_atomically(folder / DEFAULT_FILE, lambda partial: partial.write_text(text))
     return chosen

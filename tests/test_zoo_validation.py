@@ -6,7 +6,7 @@ import pytest
 import torch
 
 from patrolsb3 import cli, zoo
-from patrolsb3.checkpoints import rank, run_checkpoints, validate
+from patrolsb3.zoo.validation import rank, run_checkpoints, validate
 from patrolsb3.core import load_map, make_config, reset_state
 from patrolsb3.runs import model_steps
 from patrolsb3.sb3.train import train

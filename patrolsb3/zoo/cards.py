@@ -6,9 +6,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from . import ablation
-from .outputs import read_json
-from .report import ZOO_TABLE_METRICS, mean_std
+from .. import ablation
+from ..names import strategy_name
+from ..outputs import read_json
+from ..report import ZOO_TABLE_METRICS, mean_std
+from ..runs import ZooEntry
+from .folders import list_entries
 
 VARIANT_TEXT = {"rl-msg": "learned 16-symbol messages (RIAL)", "rl-no-msg": "positions only, no messages",
                 "rl-intention": "each agent announces its intended move (a fixed meaning)"}
@@ -35,7 +38,6 @@ def entry_name(entry: dict) -> str:
 
 def load_line(entry: dict) -> str:
     """The line of Python that loads this entry, and its strategy name."""
-    from .zoo import strategy_name
     c = entry["config"]
     extra = (", guard=True" if entry.get("guard") else "") + \
         (f", seed={entry['seed']}" if entry.get("seed") is not None else "")
@@ -51,10 +53,10 @@ ABLATIONS = ablation.MODES
 def message_figures(entry: dict) -> tuple[dict | None, dict | None]:
     """The entry's ``listening.json`` and ``ablation.json`` (written by ``zoo listening`` and
     ``zoo ablation`` beside the model), each None where the entry has none."""
-    folder = Path(entry["path"])
+    folder = ZooEntry(entry["path"])
     found = []
-    for name in ("listening.json", "ablation.json"):
-        path = folder / name
+    for path in (folder.listening_file, folder.ablation_file):
+        name = path.name
         found.append(read_json(path, f"{name} of 'patrolsb3 zoo {name.split('.')[0]}'") if path.is_file() else None)
     return found[0], found[1]
 
@@ -171,7 +173,6 @@ def card(entry: dict) -> str:
 def write_cards(out_dir, zoo_dir=None) -> list[Path]:
     """Write one card per zoo entry, ``index.md`` and ``messages.md`` into ``out_dir``; returns
     the paths."""
-    from .zoo import list_entries
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     entries = list_entries(zoo_dir)

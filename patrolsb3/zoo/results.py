@@ -1,0 +1,81 @@
+"""An entry's stored evaluation figures: one seed's eval.json result for a protocol, and the
+figures of every training seed pooled with the training seed as the unit."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..names import strategy_name
+from ..outputs import read_eval_file
+from ..runs import ZooEntry
+from ..stats import RATE_METRICS, rate_interval, seed_interval
+from .folders import entry_dir, seeds
+
+
+def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, steps: int, seed: int,
+                  tests: int = 1, zoo_dir=None, deterministic: bool = True, guard: bool = False,
+                  training_seed: int | None = None):
+    """One entry's eval.json result for exactly this protocol and action mode, or None: the
+    default seed's, or ``training_seed``'s."""
+    path = ZooEntry(entry_dir(map_name, variant, zoo_dir, seed=training_seed, guard=guard)).evaluation_file
+    if not path.is_file():
+        return None
+    data = read_eval_file(path)
+    if (data.get("episodes"), data.get("steps"), data.get("seed"), data.get("tests"),
+            data.get("deterministic", True)) != (episodes, steps, seed, tests, deterministic):
+        return None
+    found = next((r for r in data.get("results", []) if r["n_agents"] == n_agents), None)
+    return None if found is None else {**found, "strategy": strategy_name(variant, guard)}
+
+
+def pooled_result(map_name: str, variant: str, n_agents: int, episodes: int, steps: int, seed: int,
+                  tests: int = 1, zoo_dir=None, deterministic: bool = True):
+    """The paper-setting entry's figures pooled over its training seeds, from their eval.json.
+
+    Every seed whose eval.json holds this protocol and per-episode figures contributes. The
+    training seed is the unit: a mean metric's figure is the mean of the seeds' means and its 95 %
+    interval Student's t over them (:func:`patrolsb3.stats.seed_interval`), so two seeds far
+    apart give a wide interval that contains both. A rate (the battery failure rate) pools the
+    seeds' episodes and takes the exact binomial interval (:func:`patrolsb3.stats.rate_interval`):
+    with three seeds of 10 episodes, a t over three rates of 0 would say [0, 0].
+    ``summary[metric]["tests"]`` holds the seeds' own means, ``["episodes"]`` every episode. With
+    one usable seed this is that seed's result unchanged (its intervals are over its episodes:
+    a figure, not a verdict; ``claims`` tests no cell below three seeds).
+
+    Returns:
+        The result dict (like :func:`cached_result`) with ``training_seeds`` (the seeds pooled)
+        and ``unpooled_seeds`` (seeds left out: no eval.json for this protocol, or one written
+        before per-episode figures were stored), or None when no seed has such a result.
+    """
+    usable, left_out = [], []
+    for k in seeds(map_name, variant, zoo_dir):
+        r = cached_result(map_name, variant, n_agents, episodes, steps, seed, tests, zoo_dir,
+                          deterministic, training_seed=k)
+        if r is not None and all("episodes" in v for v in r["summary"].values() if isinstance(v, dict) and "ci95" in v):
+            usable.append((k, r))
+        else:
+            left_out.append(k)
+    if not usable:
+        return None
+    if len(usable) == 1:
+        return {**usable[0][1], "training_seeds": [usable[0][0]], "unpooled_seeds": left_out}
+    first = usable[0][1]
+    summary = {}
+    for metric, value in first["summary"].items():
+        if isinstance(value, dict) and "episodes" in value:
+            pooled = np.concatenate([np.asarray(r["summary"][metric]["episodes"], dtype=np.float64)
+                                     for _, r in usable])                     # (seeds x episodes,)
+            seed_means = [float(r["summary"][metric]["mean"]) for _, r in usable]
+            finite_means = [m for m in seed_means if np.isfinite(m)]
+            if metric in RATE_METRICS:        # a rate: every episode a 0 or a 1, the exact interval
+                finite = pooled[np.isfinite(pooled)]
+                mean, ci = (float(finite.mean()) if len(finite) else float("nan")), rate_interval(pooled)
+            else:                             # a mean: the training seed is the unit
+                mean = float(np.mean(finite_means)) if finite_means else float("nan")
+                ci = seed_interval(seed_means)
+            summary[metric] = {"mean": mean, "std": float(np.nanstd(seed_means)), "tests": seed_means,
+                               "ci95": ci, "episodes": [float(v) for v in pooled]}
+        elif metric == "clean_episodes":
+            summary[metric] = [int(sum(r["summary"][metric])) for _, r in usable]
+        else:
+            summary[metric] = value
+    return {**first, "summary": summary, "training_seeds": [k for k, _ in usable], "unpooled_seeds": left_out}
