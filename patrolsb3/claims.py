@@ -1,34 +1,43 @@
 """The paper's claims, one row each, tested on a comparison's figures (``patrolsb3 claims``).
 
-Read from a comparison folder's ``results.csv`` (``patrolsb3 compare``): every (map, team
-size, strategy, metric) with its mean and 95 % interval. A heuristic's interval is over its
-episodes (scipy's bootstrap of the mean); a zoo column's is over its training seeds, each seed's
-mean one draw (Student's t: the training seed is the unit); a battery failure rate's is exact
-(Clopper-Pearson) over the episodes (:mod:`patrolsb3.stats`). Idleness and collisions follow
-the paper's convention (episodes without a battery failure).
+Read from a comparison folder (``patrolsb3 compare``): ``results.csv`` (every map, team size,
+strategy and metric with its mean and 95 % interval) and ``episodes.csv`` (the per-episode
+values, episode ``i`` the same draws for every strategy: :mod:`patrolsb3.core.streams`).
+Idleness and collisions follow the paper's convention (episodes without a battery failure).
 
-How a verdict is reached, per (map, team size) cell: one strategy is *significantly* lower
-than another when its whole interval lies below the other's and both cells are testable: at
-least 10 episodes, and for a zoo column at least 3 training seeds (fewer: "too few to test",
-counted in the figure; one seed gives a figure, not a verdict). A claim that X is lowest
-**holds** when X is significantly lowest in every cell it covers, **does not hold** when
-another strategy is significantly lower than X in some cell, and is **inconclusive** otherwise.
-A claim that X is *no worse* holds when no other strategy is significantly better in any cell.
-Thresholds (near-zero failures: a rate of 0.05 at most; recharge above b_l) hold when the
-whole interval is on the claimed side and fail when it is all on the other. A cell without an
-interval (a result stored before intervals existed) cannot be significant either way. The
-comparisons are not yet paired nor adjusted for their number (issue 44).
+**The verdict rule** (docs/zoo.md, "How a verdict is reached"):
+
+- Each comparison of two strategies in a cell (map, team size) is paired: the interval of the
+  mean per-episode difference, with the training seed as the unit wherever a zoo column pools
+  several (:func:`patrolsb3.stats.paired_difference`), and its two-sided p-value.
+- A cell takes part only if it is testable: at least 10 episodes, and for a zoo column at least
+  3 training seeds (fewer: "too few to test"; one seed gives a figure, not a verdict).
+- A claim's condition is one family: Holm's procedure over all its comparisons (every cell and
+  rival) at a family-wise 5 % (:func:`patrolsb3.stats.holm`); a difference is significant when
+  Holm rejects "no difference", in the direction of its sign.
+- A claim that X is lowest **holds** when X is significantly lower than every rival in every
+  testable cell, **does not hold** when some rival is significantly lower than X in some cell,
+  and is **inconclusive** otherwise (also when no cell is testable). "No worse" holds when no
+  rival is significantly better anywhere and every cell was tested.
+- A threshold (a battery failure rate of at most 0.05; a battery at swap above b_l) is tested
+  per cell one-sided each way (a rate exactly, over the episodes of every seed; a mean by t over
+  the seeds, or the episodes of a heuristic), Holm over the cells for each direction: it holds
+  when every cell is significantly on the claimed side, fails when one is significantly on the
+  other.
 """
 from __future__ import annotations
 
 import csv
+import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from .names import display_name
 from .runs import ComparisonFolder, read_curve
-from .stats import MIN_SEEDS, seed_interval, testable
+from .stats import MIN_SEEDS, RATE_METRICS, Difference, holm, paired_difference, seed_interval, testable
 
 MSG, NOMSG, INTENTION = "zoo:rl-msg", "zoo:rl-no-msg", "zoo:rl-intention"
 LEARNED = (MSG, NOMSG, INTENTION)
@@ -41,14 +50,21 @@ NEAR_ZERO = 0.05
 HOLDS, FAILS, OPEN = "holds", "does not hold", "inconclusive"
 
 
+PAIRED_METRICS = ("max_idleness", "avg_idleness", "collisions", "battery_failure_rate", "swap_battery_pct")
+"""The metrics the claims test, whose per-episode values a comparison keeps in episodes.csv."""
+
+
 @dataclass(frozen=True)
 class Figure:
-    """A mean with its 95 % interval (nan when unknown), and whether its cell has enough
-    episodes and training seeds to decide a comparison (:func:`patrolsb3.stats.testable`)."""
+    """A mean with its 95 % interval (nan when unknown), whether its cell has enough episodes and
+    training seeds to decide a comparison (:func:`patrolsb3.stats.testable`), and its units: one
+    tuple of per-episode values per training seed (one for a heuristic), aligned by episode, or
+    None where the comparison kept none (then it cannot be paired)."""
     mean: float
     low: float
     high: float
     testable: bool = True
+    units: tuple | None = None
 
     def text(self, digits: int = 1) -> str:
         if math.isnan(self.mean):
@@ -58,9 +74,12 @@ class Figure:
         return f"{self.mean:.{digits}f} [{self.low:.{digits}f}, {self.high:.{digits}f}]"
 
 
-def below(a: Figure, b: Figure) -> bool:
-    """a is significantly lower than b (a's interval wholly below b's, both cells testable)."""
-    return a.testable and b.testable and not (math.isnan(a.high) or math.isnan(b.low)) and a.high < b.low
+def difference(a: Figure, b: Figure) -> Difference | None:
+    """The paired difference a - b (:func:`patrolsb3.stats.paired_difference`), None when either
+    has no per-episode values."""
+    if a.units is None or b.units is None:
+        return None
+    return paired_difference(a.units, b.units)
 
 
 def read_figures(results_csv) -> dict:
@@ -95,7 +114,33 @@ def read_figures(results_csv) -> dict:
                          f"run the comparison again") from None
     if not figures:
         raise ValueError(f"{path}: holds no results; run the comparison again")
-    return figures
+    units = read_episodes(path.with_name(ComparisonFolder.EPISODES_CSV))
+    return {key: dataclasses.replace(f, units=units.get(key)) for key, f in figures.items()}
+
+
+def read_episodes(episodes_csv) -> dict:
+    """{(map, n, strategy, metric): units} of a comparison's episodes.csv (:func:`patrolsb3.report.write_episodes`):
+    each unit a tuple of per-episode values (NaN where not counted), in unit order; {} when
+    there is no such file (a comparison from before paired episodes).
+
+    Raises:
+        ValueError: a damaged episodes.csv (names it).
+    """
+    path = Path(episodes_csv)
+    if not path.is_file():
+        return {}
+    found: dict = {}
+    try:
+        with path.open(newline="") as f:
+            for r in csv.DictReader(f):
+                key = (r["map"], int(r["n"]), r["strategy"], r["metric"])
+                value = float(r["value"]) if r["value"].strip() else float("nan")
+                found.setdefault(key, {}).setdefault(r["unit"], {})[int(r["episode"])] = value
+    except (ValueError, KeyError, TypeError, UnicodeDecodeError, csv.Error) as exc:
+        raise ValueError(f"{path}: not an episodes.csv written by 'patrolsb3 compare', or cut or damaged "
+                         f"({exc}); run the comparison again") from None
+    return {key: tuple(tuple(by_episode[i] for i in sorted(by_episode)) for by_episode in by_unit.values())
+            for key, by_unit in found.items()}
 
 
 def _testable(row: dict) -> bool:
@@ -114,11 +159,12 @@ def _cells(figures: dict, who: str, metric: str, maps=None, sizes=None) -> list[
 
 def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, highest: bool = False) -> dict:
     """Whether ``who`` has the lowest (or ``highest``) ``metric`` against ``rivals`` in every
-    cell: {"verdict", "figure", "cells"} (module docstring). The figure says who wins where: the
-    cells where ``who`` is best, each rival that beats it and in which cells, the level cells,
-    and one example with both intervals."""
-    wins = losses = compared = unmeasured = too_few = level = 0
-    worst, beaten_by = None, {}                 # beaten_by: rival -> cells where it beats ``who``
+    cell: {"verdict", "figure", "cells"} (the verdict rule: module docstring). The figure says who
+    wins where: the cells where ``who`` is best, each rival that beats it and in which cells, the
+    level cells, and one example with the paired difference."""
+    compared = too_few = unmeasured = 0
+    tested = []                      # ((m, n), rival, Difference of who - rival)
+    cells = []
     for m, n in _cells(figures, who, metric, maps, sizes):
         mine = figures[(m, n, who, metric)]
         others = {r: figures[(m, n, r, metric)] for r in rivals if (m, n, r, metric) in figures
@@ -126,38 +172,52 @@ def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, 
         if not others:
             continue
         compared += 1
-        cell_testable = all(f.testable for f in (mine, *others.values()))
-        too_few += not cell_testable
-        unmeasured += cell_testable and any(math.isnan(f.low) for f in (mine, *others.values()))
-        better = (lambda a, b: below(b, a)) if highest else below       # a beats b
-        if all(better(mine, o) for o in others.values()):
-            wins += 1
-        beaten = {r: o for r, o in others.items() if better(o, mine)}
-        where = f"{m}" + (f" n={n}" if n else "")
-        for r in beaten:
-            beaten_by.setdefault(r, []).append(where)
-        if beaten:
-            losses += 1
-            if worst is None:
-                r, o = next(iter(beaten.items()))
-                worst = f"map {where}: {LABEL.get(who, who)} {mine.text()} vs {LABEL.get(r, r)} {o.text()}"
-        elif cell_testable and not all(better(mine, o) for o in others.values()):
-            level += 1
+        if not all(f.testable for f in (mine, *others.values())):
+            too_few += 1
+            continue
+        diffs = {r: difference(mine, o) for r, o in others.items()}
+        if any(d is None for d in diffs.values()):
+            unmeasured += 1
+        cells.append(((m, n), list(others)))
+        tested += [((m, n), r, d) for r, d in diffs.items() if d is not None]
     if compared == 0:
         return {"verdict": OPEN, "figure": "not measured (no such cells in this comparison)", "cells": 0}
+    significant = holm([d.p for _, _, d in tested])
+    sign = 1.0 if highest else -1.0                  # a win is a difference of this sign
+    won = {(cell, r) for (cell, r, d), sig in zip(tested, significant) if sig and sign * d.mean > 0}
+    lost = {(cell, r): d for (cell, r, d), sig in zip(tested, significant) if sig and sign * d.mean < 0}
+    wins = sum(all((cell, r) in won for r in rivals_here) for cell, rivals_here in cells)
+    losing_cells = sorted({cell for cell, _ in lost})
+    beaten_by = {}
+    for (cell, r) in sorted(lost):
+        beaten_by.setdefault(r, []).append(_where(cell))
+    level = len(cells) - wins - len(losing_cells)
     word = "highest" if highest else "lowest"
-    figure = f"significantly {word} in {wins} of {compared} cells; significantly beaten in {losses}"
+    figure = f"significantly {word} in {wins} of {compared} cells; significantly beaten in {len(losing_cells)}"
     if beaten_by:            # who wins where
         figure += " (" + "; ".join(f"by {LABEL.get(r, r)} in {len(c)}: {', '.join(c)}" for r, c in beaten_by.items()) + ")"
     figure += f"; level in {level}"
-    figure += _untested_and_example(unmeasured, too_few, worst)
-    verdict = FAILS if losses else HOLDS if wins == compared else OPEN
+    example = None
+    if lost:
+        (cell, r), d = next(iter(sorted(lost.items())))
+        example = f"map {_where(cell)}: {LABEL.get(who, who)} - {LABEL.get(r, r)} = {d.text()} over {d.unit}"
+    elif won:
+        cell, r = sorted(won)[0]
+        d = next(d for c, rr, d in tested if (c, rr) == (cell, r))
+        example = f"map {_where(cell)}: {LABEL.get(who, who)} - {LABEL.get(r, r)} = {d.text()} over {d.unit}"
+    figure += _untested_and_example(unmeasured, too_few, example)
+    verdict = FAILS if lost else HOLDS if wins == compared else OPEN
     return {"verdict": verdict, "figure": figure, "cells": compared, "unmeasured": unmeasured}
+
+
+def _where(cell) -> str:
+    m, n = cell
+    return f"{m}" + (f" n={n}" if n else "")
 
 
 def _untested_and_example(unmeasured: int, too_few: int, example: str | None) -> str:
     """The tail of a claim's figure: the cells without an interval, those below the floor, an example."""
-    tail = f"; {unmeasured} cells without an interval" if unmeasured else ""
+    tail = f"; {unmeasured} cells without per-episode figures to pair" if unmeasured else ""
     if too_few:
         tail += f"; {too_few} cells too few to test (fewer than 3 training seeds or 10 episodes)"
     return tail + (f" (e.g. {example})" if example else "")
@@ -172,30 +232,63 @@ def no_worse(figures: dict, who: str, rivals, metric: str, maps=None) -> dict:
 
 
 def threshold(figures: dict, who_list, metric: str, limit: float, above: bool, maps=None) -> dict:
-    """Whether every cell of ``who_list`` has ``metric`` above (or at most) ``limit``."""
-    held = failed = compared = unmeasured = too_few = 0
-    example = None
+    """Whether every cell of ``who_list`` has ``metric`` above (or at most) ``limit``: each testable
+    cell tested one-sided each way (:func:`side_p_values`), Holm over the cells for each side."""
+    compared = too_few = unmeasured = 0
+    tested = []                        # ((m, n, who), p of the claimed side, p of the other side, Figure)
     for who in who_list:
         for m, n in _cells(figures, who, metric, maps):
             f = figures[(m, n, who, metric)]
             compared += 1
-            unmeasured += f.testable and math.isnan(f.low)
-            too_few += not f.testable
-            if above:
-                ok, bad = f.low > limit, f.high < limit
-            else:
-                ok, bad = f.high <= limit, f.low > limit
-            ok, bad = ok and f.testable, bad and f.testable
-            held += ok
-            failed += bad
-            if bad and example is None:
-                example = f"map {m} n={n}: {LABEL.get(who, who)} {f.text(2)}"
+            if not f.testable:
+                too_few += 1
+                continue
+            sides = side_p_values(f, metric, limit, above)
+            if sides is None:
+                unmeasured += 1
+                continue
+            tested.append(((m, n, who), *sides, f))
     if compared == 0:
         return {"verdict": OPEN, "figure": "not measured (no such cells in this comparison)", "cells": 0}
-    figure = f"{held} of {compared} cells clearly {'above' if above else 'at or below'} {limit:g}, {failed} clearly not"
+    held = holm([t[1] for t in tested])
+    failed = holm([t[2] for t in tested])
+    example = next((f"map {m} n={n}: {LABEL.get(who, who)} {f.text(2)}"
+                    for ((m, n, who), _, _, f), bad in zip(tested, failed) if bad), None)
+    figure = (f"{sum(held)} of {compared} cells significantly {'above' if above else 'at or below'} {limit:g}, "
+              f"{sum(failed)} significantly not")
     figure += _untested_and_example(unmeasured, too_few, example)
-    return {"verdict": FAILS if failed else HOLDS if held == compared else OPEN, "figure": figure,
+    return {"verdict": FAILS if any(failed) else HOLDS if sum(held) == compared else OPEN, "figure": figure,
             "cells": compared}
+
+
+def side_p_values(figure: Figure, metric: str, limit: float, above: bool) -> tuple[float, float] | None:
+    """One-sided p-values of a cell against ``limit``: (that it is on the claimed side, that it is
+    on the other), or None without per-episode values. A rate pools every seed's episodes and
+    takes scipy's exact binomial test; a mean takes Student's t over the training seeds' means
+    (a zoo column of several seeds) or over the episodes (a heuristic, one model)."""
+    from scipy.stats import binomtest, ttest_1samp
+    if figure.units is None:
+        return None
+    units = [np.asarray(u, dtype=np.float64) for u in figure.units]
+    if metric in RATE_METRICS:
+        values = np.concatenate(units)
+        values = values[np.isfinite(values)]
+        if len(values) == 0:
+            return None
+        k, n = int(values.sum()), len(values)
+        less, greater = binomtest(k, n, limit, alternative="less").pvalue, binomtest(k, n, limit, alternative="greater").pvalue
+    else:
+        values = np.array([np.nanmean(u) for u in units if np.isfinite(u).any()]) if len(units) > 1 else units[0]
+        values = values[np.isfinite(values)]
+        if len(values) < 2:
+            return None
+        if np.ptp(values) == 0:
+            less, greater = float(values[0] < limit), float(values[0] > limit)
+            less, greater = 1.0 - less, 1.0 - greater       # a p of 0 on the side it lies on
+        else:
+            less = ttest_1samp(values, limit, alternative="less").pvalue
+            greater = ttest_1samp(values, limit, alternative="greater").pvalue
+    return (float(greater), float(less)) if above else (float(less), float(greater))
 
 
 def both(*parts: dict) -> dict:
@@ -228,7 +321,8 @@ def training_reward(curves: dict, fraction: float = 0.2) -> dict:
                 continue
             low, high = seed_interval(tails)
             figures[(m, 0, f"zoo:{variant}", "training_reward")] = Figure(
-                sum(tails) / len(tails), low, high, testable=len(tails) >= MIN_SEEDS)
+                sum(tails) / len(tails), low, high, testable=len(tails) >= MIN_SEEDS,
+                units=tuple((t,) for t in tails))       # one value a seed: compared by Welch's t over seeds
     return lowest(figures, MSG, LEARNED, "training_reward", highest=True)
 
 
@@ -308,21 +402,30 @@ def claims(figures: dict, curves: dict | None = None, faults_result: dict | None
 
 
 def _not_better(figures: dict, who: str, than: str, metric: str) -> dict:
-    """``who`` is not significantly lower than ``than`` in any cell."""
-    compared = better = 0
+    """``who`` is not significantly lower than ``than`` in any testable cell (paired, Holm over the cells)."""
+    compared = too_few = 0
+    tested = []
     for m, n in _cells(figures, who, metric):
         rival = figures.get((m, n, than, metric))
-        if rival is not None and not math.isnan(rival.mean):
-            compared += 1
-            better += below(figures[(m, n, who, metric)], rival)
+        if rival is None or math.isnan(rival.mean):
+            continue
+        compared += 1
+        mine = figures[(m, n, who, metric)]
+        if not (mine.testable and rival.testable):
+            too_few += 1
+        elif (d := difference(mine, rival)) is not None:
+            tested.append(d)
     if compared == 0:
         return {"verdict": OPEN, "figure": "not measured (no such cells in this comparison)", "cells": 0}
-    return {"verdict": FAILS if better else HOLDS, "cells": compared,
-            "figure": f"{LABEL[who]} significantly lower than {LABEL[than]} in {better} of {compared} cells"}
+    better = sum(sig and d.mean < 0 for d, sig in zip(tested, holm([d.p for d in tested])))
+    figure = (f"{LABEL[who]} significantly lower than {LABEL[than]} in {better} of {compared} cells"
+              + _untested_and_example(compared - too_few - len(tested), too_few, None))
+    verdict = FAILS if better else HOLDS if len(tested) == compared else OPEN
+    return {"verdict": verdict, "cells": compared, "figure": figure}
 
 
 def claims_table(rows: list[dict]) -> str:
     """The claims as a markdown table."""
-    lines = ["| the paper's claim | our figure (95 % intervals over episodes, and over training seeds where a zoo column pools several) | verdict |", "|---|---|---|"]
+    lines = ["| the paper's claim | our figure (paired differences on the same episodes, 95 % intervals over training seeds where a zoo column pools several, Holm over each claim's comparisons) | verdict |", "|---|---|---|"]
     lines += [f"| {r['claim']} | {r['figure']} | **{r['verdict']}** |" for r in rows]
     return "\n".join(lines)

@@ -21,6 +21,7 @@ from .core.maps import load_map
 from .core.metrics import EpisodeMetrics, idleness_lower_bounds
 from .core.state import reset_state
 from .core.step import step
+from .core.streams import STREAMS_VERSION
 from .names import canonical_name, is_learned
 from .summary import summarize
 
@@ -44,7 +45,7 @@ def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0, device: str 
 
 
 def run_episodes(policy, spec, cfg, n_agents: int, n_envs: int, seed: int = 0, progress=False,
-                 desc: str = "", deterministic: bool = True) -> dict:
+                 desc: str = "", deterministic: bool = True, episode_ids=None) -> dict:
     """Run ``n_envs`` episodes of ``cfg.episode_steps`` steps together.
 
     Args:
@@ -54,6 +55,10 @@ def run_episodes(policy, spec, cfg, n_agents: int, n_envs: int, seed: int = 0, p
         n_agents: team size of every episode.
         n_envs: episodes E.
         seed: seed of the simulator.
+        episode_ids: (E,) int, each episode's id (default 0 .. E-1): episode ``i`` of ``seed``
+            meets the same starts, wind, drains, swap times and faults in every batch
+            (:mod:`patrolsb3.core.streams`); a batch of several team sizes gives episode j of
+            each size the id j, so that they are paired.
         progress: show a tqdm progress bar over steps.
         desc: label of the progress bar.
         deterministic: passed to ``predict``: a learned policy takes its most likely legal
@@ -62,7 +67,7 @@ def run_episodes(policy, spec, cfg, n_agents: int, n_envs: int, seed: int = 0, p
     Returns:
         The per-episode figures of :meth:`EpisodeMetrics.result` plus ``segments``.
     """
-    sim = reset_state(spec, cfg, n_agents, n_envs=n_envs, seed=seed)
+    sim = reset_state(spec, cfg, n_agents, n_envs=n_envs, seed=seed, episode_ids=episode_ids)
     metrics = EpisodeMetrics(n_envs, spec.n_vertices, boundaries=[s + 1 for s, _ in cfg.faults])
     if not deterministic and hasattr(policy, "seed_sampling"):
         policy.seed_sampling(seed)                     # sampled actions reproducible per seed
@@ -131,7 +136,7 @@ def request_of(strategy: str, spec, n_agents: int, episodes: int, tests: int, st
     return {"strategy": canonical_name(strategy), "map": spec.name, "n_agents": int(n_agents),
             "episodes": int(episodes), "tests": int(tests), "steps": int(steps), "seed": int(seed),
             "faults": [list(f) for f in cfg.faults], "deterministic": bool(deterministic),
-            "env": cfg.to_dict()}
+            "env": cfg.to_dict(), "draws": STREAMS_VERSION}
 
 
 def evaluation_setup(map_name, n_agents: int, episodes: int, tests: int, steps: int, faults=(), **env):

@@ -20,7 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .claims import claims, claims_table, read_figures
+from .claims import PAIRED_METRICS, claims, claims_table, read_figures
+from .core.streams import STREAMS_VERSION
 from .learning_curves import plot_learning_curves
 from .names import display_name, is_learned
 from .runs import ComparisonFolder
@@ -219,6 +220,7 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
                                  sum(r["summary"]["clean_episodes"]), r["episodes"] * r["tests"],
                                  r["tests"], r["steps"], r.get("deterministic", True), seeds])
     written.append(long_path)
+    written.append(write_episodes(results, ComparisonFolder(out).episodes_csv))
     if any(is_learned(r.get("strategy", "")) for r in results):   # the claims head the report
         rows = claims(read_figures(long_path), curves=learning_curves, faults_result=faults_result)
         md[2:2] = ["## The paper's claims on these figures", "",
@@ -228,6 +230,33 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
     report.write_text("\n".join(md) + "\n")
     written.append(report)
     return written
+
+
+def write_episodes(results: list[dict], path) -> Path:
+    """Write the per-episode values the claims pair (:data:`patrolsb3.claims.PAIRED_METRICS`) as a
+    long CSV: map, n, strategy, metric, unit (a zoo column's training seed; empty for a
+    heuristic or a single model), episode (its index in the evaluation, the same episode for
+    every strategy: :mod:`patrolsb3.core.streams`), value (empty where the metric does not count
+    the episode). Results evaluated before the paired streams (no ``draws`` field) are left out:
+    their episodes do not pair."""
+    path = Path(path)
+    with path.open("w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(["map", "n", "strategy", "metric", "unit", "episode", "value"])
+        for r in results:
+            if r.get("draws") != STREAMS_VERSION:
+                continue
+            for metric in PAIRED_METRICS:
+                s = r["summary"].get(metric)
+                if not isinstance(s, dict) or "episodes" not in s:
+                    continue
+                units = s.get("units") or [s["episodes"]]
+                labels = r.get("training_seeds") if s.get("units") else [""]
+                for label, values in zip(labels, units):
+                    for i, v in enumerate(values):
+                        writer.writerow([r["map"], r["n_agents"], r["strategy"], metric, label, i,
+                                         "" if v is None or not math.isfinite(float(v)) else v])
+    return path
 
 
 def _error_bars(rows: list[dict], metric: str, means: np.ndarray):

@@ -16,7 +16,7 @@ from .names import is_learned
 from .outputs import read_results, write_json
 from .runs import ComparisonFolder
 
-PROTOCOL_KEYS = ("strategy", "map", "n_agents", "episodes", "tests", "steps", "seed", "faults", "env")
+PROTOCOL_KEYS = ("strategy", "map", "n_agents", "episodes", "tests", "steps", "seed", "faults", "env", "draws")
 """Result fields that must match for a stored result to stand for a new run."""
 
 

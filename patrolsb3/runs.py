@@ -25,7 +25,8 @@ Zoo entry ``zoo/<MAP>/<variant>/seed<k>/`` (:class:`ZooEntry`): a run's ``model.
 policy only), ``config.yml``, ``command.txt``, ``curve.csv``, ``cpu_time.csv``, and its
 figures ``eval.json`` (``zoo eval``), ``listening.json`` and ``ablation.json``; the variant
 folder's ``default.yml`` names the default seed. Comparison ``<out>/`` (:class:`ComparisonFolder`):
-``results.json`` (every result, written as each finishes), ``results.csv``, ``report.md``.
+``results.json`` (every result, written as each finishes), ``results.csv`` (every figure with its
+interval), ``episodes.csv`` (the per-episode values the claims pair) and ``report.md``.
 """
 from __future__ import annotations
 
@@ -446,11 +447,12 @@ class ComparisonFolder:
         path: the folder (need not exist yet).
     """
 
-    RESULTS_JSON, RESULTS_CSV, REPORT = "results.json", "results.csv", "report.md"
+    RESULTS_JSON, RESULTS_CSV, EPISODES_CSV, REPORT = "results.json", "results.csv", "episodes.csv", "report.md"
 
     def __init__(self, path):
         self.path = Path(path)
 
     results_json = _in_folder("RESULTS_JSON")
     results_csv = _in_folder("RESULTS_CSV")
+    episodes_csv = _in_folder("EPISODES_CSV")
     report = _in_folder("REPORT")

@@ -30,9 +30,12 @@ def summarize(per_episode: dict, tests: int) -> dict:
     Returns:
         dict metric -> {"mean", "std", "tests": [per-test values], "ci95": [low, high],
         "episodes": [per-episode values]}: std over tests, and a 95 % interval over the episodes
-        themselves (:func:`patrolsb3.stats.interval`: exact for the battery failure rate, the
-        bootstrap of the mean otherwise; the episodes a metric counts,
-        kept so that the seeds of a zoo entry can be pooled: ``patrolsb3.zoo.pooled_result``), plus ``clean_episodes`` (per-test
+        the metric counts (:func:`patrolsb3.stats.interval`: exact for the battery failure rate,
+        the bootstrap of the mean otherwise). ``episodes`` has one value per episode, in episode
+        order (episode e: test ``e // episodes``), NaN where the metric does not count it (an
+        episode with a battery failure for the clean metrics, one without a swap for the battery
+        at swap): what pools a zoo entry's seeds (``patrolsb3.zoo.pooled_result``) and pairs two
+        strategies episode by episode (:mod:`patrolsb3.claims`). Plus ``clean_episodes`` (per-test
         counts of episodes without a battery failure) and ``segments``.
     """
     failed = per_episode["failed"].reshape(tests, -1)                        # (T, N)
@@ -59,7 +62,7 @@ def summarize(per_episode: dict, tests: int) -> dict:
 
     for name in CLEAN_METRICS:
         values = np.asarray(per_episode[name], dtype=np.float64)
-        out[name] = stats(clean_mean(values), values[clean.reshape(-1)])
+        out[name] = stats(clean_mean(values), np.where(clean.reshape(-1), values, np.nan))
         # the same over every episode, failed ones included (not in the paper's tables; it
         # keeps a strategy whose every episode fails from having no idleness figure at all)
         out[f"{name}_all"] = stats(values.reshape(tests, -1).mean(axis=1), values)
@@ -71,7 +74,8 @@ def summarize(per_episode: dict, tests: int) -> dict:
     level = np.nan_to_num(per_episode["swap_battery"]).reshape(tests, -1) * swaps
     with np.errstate(invalid="ignore", divide="ignore"):
         out["swap_battery_pct"] = stats(100.0 * level.sum(axis=1) / swaps.sum(axis=1),
-                                        100.0 * np.asarray(per_episode["swap_battery"])[swaps.reshape(-1) > 0])
+                                        np.where(swaps.reshape(-1) > 0, 100.0 * np.asarray(per_episode["swap_battery"]),
+                                                 np.nan))
     out["clean_episodes"] = [int(n) for n in clean.sum(axis=1)]
     out["segments"] = [{"start": s["start"], "end": s["end"],
                         "avg_idleness": stats(clean_mean(s["avg"])),

@@ -6,7 +6,6 @@ rewards and idleness can be written down exactly.
 """
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from patrolsb3.core import make_config, parse_map, reset_state
@@ -64,26 +63,25 @@ def cell(spec, r, c):
     return r * spec.shape[1] + c
 
 
-def seed_drawing_pushes(n_slots, wanted, limit=10_000):
-    """A seed whose generator, used by ``core.step``, pushes slots in the wanted directions.
+def streams_drawing_pushes(n_slots, wanted, limit=10_000):
+    """Random streams of one episode whose first step pushes slots in the wanted directions.
 
-    ``core.step`` draws ``rng.random((E, A))`` (who is pushed) and then
-    ``rng.integers(0, 4, (E, A))`` (the push direction, an index into Up, Down, Left, Right).
-    With ``p_dyn = 1`` a slot is always pushed, so the direction is the second draw.
+    ``core.step`` reads each step's push directions from the episode's world stream
+    (:class:`patrolsb3.core.streams.StepDraws`); with ``p_dyn = 1`` a slot is always pushed.
 
     Args:
         n_slots: A (max_agents).
         wanted: {slot: direction}.
 
     Returns:
-        The first seed that draws those directions.
+        The :class:`EpisodeStreams` of the first seed that draws those directions; assign it to
+        ``state.streams`` before the step.
     """
+    from patrolsb3.core.streams import EpisodeStreams
     for seed in range(limit):
-        rng = np.random.default_rng(seed)
-        rng.random((1, n_slots))
-        direction = rng.integers(0, 4, size=(1, n_slots))[0]
+        direction = EpisodeStreams(seed, [0], n_slots).step().push_direction()[0]
         if all(direction[k] == d for k, d in wanted.items()):
-            return seed
+            return EpisodeStreams(seed, [0], n_slots)
     raise AssertionError(f"no seed below {limit} draws pushes {wanted}")
 
 

@@ -5,9 +5,12 @@ import json
 
 import pytest
 
+import numpy as np
+
 from patrolsb3 import cli
-from patrolsb3.claims import (FAILS, HOLDS, OPEN, Figure, below, claims, fault_tolerance, lowest, no_worse,
+from patrolsb3.claims import (FAILS, HOLDS, OPEN, Figure, claims, difference, fault_tolerance, lowest, no_worse,
                               read_figures, threshold)
+from patrolsb3.stats import holm
 
 FIELDS = ["map", "n", "strategy", "metric", "mean", "std", "ci95_low", "ci95_high"]
 
@@ -20,20 +23,21 @@ def write_results(path, rows):
     return path
 
 
-def fig(mean, half=1.0):
-    return Figure(mean, mean - half, mean + half)
+def episodes(mean, spread=1.0, seed=0, n=12):
+    """n per-episode values around ``mean``: the episode's own noise, drawn from ``seed``."""
+    return tuple(mean + spread * np.random.default_rng(seed).standard_normal(n))
 
 
-def test_significance_is_intervals_that_do_not_overlap():
-    assert below(fig(1), fig(5)) and not below(fig(1), fig(2.5)) and not below(fig(5), fig(1))
-    assert not below(Figure(1, float("nan"), float("nan")), fig(5))     # no interval: never significant
+def fig(mean, spread=1.0, seed=0, testable=True):
+    """A heuristic-like figure: one unit of 12 episodes around ``mean``."""
+    return Figure(mean, mean - spread, mean + spread, testable=testable, units=(episodes(mean, spread, seed),))
 
 
 def test_lowest_holds_fails_or_stays_open():
-    figures = {("A", 1, "me", "x"): fig(1), ("A", 1, "you", "x"): fig(5),
-               ("A", 2, "me", "x"): fig(1), ("A", 2, "you", "x"): fig(2)}
+    figures = {("A", 1, "me", "x"): fig(1, seed=1), ("A", 1, "you", "x"): fig(5, seed=2),
+               ("A", 2, "me", "x"): fig(1, seed=3), ("A", 2, "you", "x"): fig(1.2, seed=4)}
     assert lowest(figures, "me", ["you"], "x", sizes=[1])["verdict"] == HOLDS
-    assert lowest(figures, "me", ["you"], "x")["verdict"] == OPEN                  # n=2 overlaps
+    assert lowest(figures, "me", ["you"], "x")["verdict"] == OPEN                  # n=2 level
     assert lowest(figures, "you", ["me"], "x")["verdict"] == FAILS
     assert lowest(figures, "you", ["me"], "x", highest=True)["verdict"] == OPEN
     assert no_worse(figures, "me", ["you"], "x")["verdict"] == HOLDS
@@ -41,22 +45,70 @@ def test_lowest_holds_fails_or_stays_open():
     assert lowest(figures, "me", ["nobody"], "x")["verdict"] == OPEN
 
 
-def test_no_worse_without_intervals_is_inconclusive():
+def test_pairing_finds_a_small_steady_difference_that_unpaired_intervals_hide():
+    hardness = np.linspace(0, 100, 12)                        # some episodes are much harder than others
+    me = Figure(49.0, 30.0, 68.0, units=(tuple(hardness - 1.0 + 0.1 * np.sin(np.arange(12))),))
+    you = Figure(50.0, 31.0, 69.0, units=(tuple(hardness),))
+    d = difference(me, you)
+    assert d.high < 0 and d.unit == "episodes"               # paired: clearly lower, by about 1
+    assert me.high > you.low                                 # the unpaired intervals overlap widely
+    assert lowest({("A", 1, "me", "x"): me, ("A", 1, "you", "x"): you}, "me", ["you"], "x")["verdict"] == HOLDS
+
+
+def test_holm_adjusts_a_claims_comparisons_for_their_number():
+    assert holm([0.01, 0.04, 0.03, 0.005]) == [True, False, False, True]    # a known example
+    assert holm([0.04]) == [True] and holm([]) == []
+    # three cells each significant alone (p about 0.03) are not, as a family of three
+    rng = np.random.default_rng(7)
+    base = rng.normal(0, 1, 12)
+    figures = {}
+    for n in (1, 2, 3):
+        noise = rng.normal(0, 1, 12)
+        shift = -0.72 * noise.std(ddof=1) - noise.mean()      # a mean difference about 2.2 standard errors
+        figures[("A", n, "you", "x")] = Figure(0, -1, 1, units=(tuple(base),))
+        figures[("A", n, "me", "x")] = Figure(0, -1, 1, units=(tuple(base + noise + shift),))
+    p = [difference(figures[("A", n, "me", "x")], figures[("A", n, "you", "x")]).p for n in (1, 2, 3)]
+    assert all(0.01 < v < 0.05 for v in p)
+    result = lowest(figures, "me", ["you"], "x")
+    assert result["verdict"] == OPEN and "level in 3" in result["figure"]
+    assert lowest(figures, "me", ["you"], "x", sizes=[1])["verdict"] == HOLDS      # alone, one is enough
+
+
+def test_no_worse_without_per_episode_figures_is_inconclusive():
     nan = float("nan")
     figures = {("A", 1, "me", "x"): Figure(1, nan, nan), ("A", 1, "you", "x"): Figure(5, nan, nan)}
     result = no_worse(figures, "me", ["you"], "x")
-    assert result["verdict"] == OPEN and "without an interval" in result["figure"]
+    assert result["verdict"] == OPEN and "without per-episode figures" in result["figure"]
 
 
 def test_thresholds():
-    figures = {("A", 1, "zoo:rl-msg", "bf"): fig(0.01, 0.01), ("C", 1, "zoo:rl-msg", "bf"): fig(0.5, 0.1)}
-    assert threshold(figures, ["zoo:rl-msg"], "bf", 0.05, above=False, maps=["A"])["verdict"] == HOLDS
-    result = threshold(figures, ["zoo:rl-msg"], "bf", 0.05, above=False)
+    rate = "battery_failure_rate"
+    none_in = lambda k: Figure(0.0, 0.0, 0.1, units=(tuple([0.0] * k),))
+    assert threshold({("A", 1, "zoo:rl-msg", rate): none_in(100)}, ["zoo:rl-msg"], rate, 0.05,
+                     above=False)["verdict"] == HOLDS
+    # a rate of 0 in 30 does not show a rate of at most 0.05 (its exact upper bound is 0.116)
+    assert threshold({("A", 1, "zoo:rl-msg", rate): none_in(30)}, ["zoo:rl-msg"], rate, 0.05,
+                     above=False)["verdict"] == OPEN
+    figures = {("A", 1, "zoo:rl-msg", rate): none_in(100),
+               ("C", 1, "zoo:rl-msg", rate): Figure(0.5, 0.4, 0.6, units=(tuple([0.0, 1.0] * 15),))}
+    result = threshold(figures, ["zoo:rl-msg"], rate, 0.05, above=False)
     assert result["verdict"] == FAILS and "map C" in result["figure"]
+    swap = {("A", 1, "zoo:rl-msg", "swap_battery_pct"): fig(30.0, spread=2.0)}
+    assert threshold(swap, ["zoo:rl-msg"], "swap_battery_pct", 20.0, above=True)["verdict"] == HOLDS
+
+
+def write_episodes(path, figures):
+    """An episodes.csv for ``figures`` ({(map, n, strategy, metric): units})."""
+    with path.open("w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(["map", "n", "strategy", "metric", "unit", "episode", "value"])
+        for (m, n, s, metric), units in figures.items():
+            for k, unit in enumerate(units):
+                writer.writerows([m, n, s, metric, k if len(units) > 1 else "", i, v] for i, v in enumerate(unit))
 
 
 def test_every_claim_has_a_row_and_the_clear_cases_get_their_verdict(tmp_path):
-    rows = []
+    rows, units = [], {}
     for m in "ABCD":
         for n in (1, 2):
             for s, avg, mx, coll, bf, swap in (("CR", 50, 150, 30, 0.0, 25), ("PART", 45, 120, 5, 0.0, 25),
@@ -64,11 +116,22 @@ def test_every_claim_has_a_row_and_the_clear_cases_get_their_verdict(tmp_path):
                                                ("zoo:rl-msg", 30, 60, 1, 0.0, 30),
                                                ("zoo:rl-no-msg", 35, 80, 2, 0.2, 30),
                                                ("zoo:rl-intention", 38, 90, 2, 0.3, 10)):
+                seeds = 3 if s.startswith("zoo:") else 1
                 for metric, v in (("avg_idleness", avg), ("max_idleness", mx), ("collisions", coll),
                                   ("battery_failure_rate", bf), ("swap_battery_pct", swap)):
-                    half = 0.01 if metric == "battery_failure_rate" else 1.0
-                    rows.append([m, n, s, metric, v, 0, v - half, v + half])
-    figures = read_figures(write_results(tmp_path / "results.csv", rows))
+                    rows.append([m, n, s, metric, v, 0, v - 1, v + 1])
+                    if metric == "battery_failure_rate":      # every 1/bf-th episode fails
+                        one = tuple(float(i % round(1 / bf) == 0) if bf else 0.0 for i in range(40))
+                        units[(m, n, s, metric)] = (one,) * seeds
+                    else:
+                        units[(m, n, s, metric)] = tuple(episodes(v, 0.5, seed=k, n=40) for k in range(seeds))
+    write_episodes(tmp_path / "episodes.csv", units)
+    rows = [r + [40, 3 if r[2].startswith("zoo:") else ""] for r in rows]
+    with (tmp_path / "results.csv").open("w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(FIELDS + ["episodes", "training_seeds"])
+        writer.writerows(rows)
+    figures = read_figures(tmp_path / "results.csv")
     verdicts = {r["claim"]: r["verdict"] for r in claims(figures)}
     assert len(verdicts) == 10
     assert verdicts["RL-MSG has the lowest MAX^h on every map"] == HOLDS
@@ -158,10 +221,9 @@ def test_the_training_reward_claim_takes_every_seed_as_a_unit(tmp_path):
 
 
 def test_the_figure_says_who_wins_where():
-    from patrolsb3.claims import Figure, lowest
-    figures = {("A", 1, "zoo:rl-msg", "max_idleness"): Figure(5.0, 4.9, 5.1),
-               ("A", 1, "CR", "max_idleness"): Figure(1.0, 0.9, 1.1),
-               ("A", 2, "zoo:rl-msg", "max_idleness"): Figure(3.0, 2.0, 4.0),
-               ("A", 2, "CR", "max_idleness"): Figure(3.1, 2.1, 4.1)}
+    figures = {("A", 1, "zoo:rl-msg", "max_idleness"): fig(5.0, 0.1, seed=1),
+               ("A", 1, "CR", "max_idleness"): fig(1.0, 0.1, seed=2),
+               ("A", 2, "zoo:rl-msg", "max_idleness"): fig(3.0, seed=3),
+               ("A", 2, "CR", "max_idleness"): fig(3.1, seed=4)}
     figure = lowest(figures, "zoo:rl-msg", ["CR"], "max_idleness")["figure"]
     assert "significantly beaten in 1 (by CR in 1: A n=1); level in 1" in figure

@@ -189,6 +189,9 @@ def test_summary_also_averages_over_every_episode():
     s = summarize(per_episode, tests=2)
     assert s["avg_idleness"]["tests"] == [2.0, 4.0]              # clean episodes only
     assert s["avg_idleness_all"]["tests"] == [6.0, 12.0]         # every episode
-    # the episodes each figure counts are kept, so that training seeds can be pooled later
-    assert s["avg_idleness"]["episodes"] == [2.0, 4.0] and s["avg_idleness_all"]["episodes"] == [10.0, 2.0, 4.0, 20.0]
-    assert s["swap_battery_pct"]["episodes"] == pytest.approx([20.0, 30.0])
+    # every episode's value is kept in episode order (NaN where the figure does not count it), so
+    # that training seeds can be pooled and two strategies paired episode by episode
+    assert s["avg_idleness"]["episodes"] == pytest.approx([np.nan, 2.0, 4.0, np.nan], nan_ok=True)
+    assert s["avg_idleness_all"]["episodes"] == [10.0, 2.0, 4.0, 20.0]
+    assert s["swap_battery_pct"]["episodes"] == pytest.approx([np.nan, 20.0, 30.0, np.nan], nan_ok=True)
+    assert s["avg_idleness"]["ci95"][0] >= 2.0 and s["avg_idleness"]["ci95"][1] <= 4.0

@@ -59,14 +59,15 @@ def test_an_interval_over_seeds_contains_the_seed_means_of_a_bimodal_case():
 
 
 def test_too_few_to_test_below_the_floor():
-    from patrolsb3.claims import Figure, below, lowest
+    from patrolsb3.claims import Figure, lowest
     from patrolsb3.stats import testable
     assert testable(10, None) and testable(10, 3)
     assert not testable(9, None) and not testable(10, 2) and not testable(10, 1)
-    low, high = Figure(1.0, 0.9, 1.1), Figure(5.0, 4.9, 5.1)
-    assert below(low, high)
-    assert not below(Figure(1.0, 0.9, 1.1, testable=False), high)      # clearly apart, but too few
-    figures = {("A", 1, "zoo:rl-msg", "max_idleness"): Figure(1.0, 0.9, 1.1, testable=False),
-               ("A", 1, "CR", "max_idleness"): high}
+    low = (tuple(np.linspace(0.9, 1.1, 12)),)
+    high = Figure(5.0, 4.9, 5.1, units=(tuple(np.linspace(4.9, 5.1, 12)[::-1]),))
+    clear = {("A", 1, "zoo:rl-msg", "max_idleness"): Figure(1.0, 0.9, 1.1, units=low), ("A", 1, "CR", "max_idleness"): high}
+    assert lowest(clear, "zoo:rl-msg", ["CR"], "max_idleness")["verdict"] == "holds"
+    figures = {("A", 1, "zoo:rl-msg", "max_idleness"): Figure(1.0, 0.9, 1.1, testable=False, units=low),
+               ("A", 1, "CR", "max_idleness"): high}                # clearly apart, but too few
     result = lowest(figures, "zoo:rl-msg", ["CR"], "max_idleness")
     assert result["verdict"] == "inconclusive" and "1 cells too few to test" in result["figure"]

@@ -7,7 +7,7 @@ from patrolsb3.core.masks import action_mask
 from patrolsb3.core.state import ABSENT, ACTIVE, FAILED, SWAPPING, reset_state
 from patrolsb3.core.step import InvalidActionError, resolve_collisions, step
 
-from conftest import cell, deterministic_config, place, seed_drawing_pushes
+from conftest import cell, deterministic_config, place, streams_drawing_pushes
 
 
 def moves(*m):
@@ -143,10 +143,9 @@ def test_contested_cell_with_three_movers_is_one_event():
 def test_swap_conflict_by_two_pushes_both_stay(line_map):
     spec = line_map
     cfg = deterministic_config(max_agents=2)
-    seed = seed_drawing_pushes(2, {0: RIGHT, 1: LEFT})
     state = place(spec, cfg, [(0, 2), (0, 3)])
     state.p_dyn[0] = 1.0
-    state.rng = np.random.default_rng(seed)
+    state.streams = streams_drawing_pushes(2, {0: RIGHT, 1: LEFT})
     info = step(spec, cfg, state, moves(STAY, STAY))
     assert list(info.pushed[0]) == [True, True]
     assert list(state.pos[0]) == [2, 3]
@@ -159,7 +158,7 @@ def test_swap_conflict_rule_directly(line_map):
     pos = np.array([[2, 3, 5]])
     target = np.array([[3, 2, 4]])
     new_pos, collided, events = resolve_collisions(line_map, pos, target, np.ones((1, 3), bool),
-                                                   np.random.default_rng(0))
+                                                   np.random.default_rng(0).random((1, 3)))
     assert list(new_pos[0]) == [2, 3, 4]
     assert list(collided[0]) == [True, True, False]
     assert events[0] == 1
@@ -168,10 +167,9 @@ def test_swap_conflict_rule_directly(line_map):
 def test_chain_moves_when_the_front_agent_moves(line_map):
     spec = line_map
     cfg = deterministic_config(max_agents=2)
-    seed = seed_drawing_pushes(2, {0: RIGHT})
     state = place(spec, cfg, [(0, 1), (0, 2)])
     state.p_dyn[0, 0] = 1.0                        # slot 0 is pushed into slot 1's cell
-    state.rng = np.random.default_rng(seed)
+    state.streams = streams_drawing_pushes(2, {0: RIGHT})
     info = step(spec, cfg, state, moves(STAY, RIGHT))
     assert list(info.pushed[0]) == [True, False]
     assert list(state.pos[0]) == [2, 3]
@@ -182,10 +180,9 @@ def test_chain_moves_when_the_front_agent_moves(line_map):
 def test_chain_blocked_when_the_front_agent_stays(line_map):
     spec = line_map
     cfg = deterministic_config(max_agents=2)
-    seed = seed_drawing_pushes(2, {0: RIGHT})
     state = place(spec, cfg, [(0, 1), (0, 2)])
     state.p_dyn[0, 0] = 1.0
-    state.rng = np.random.default_rng(seed)
+    state.streams = streams_drawing_pushes(2, {0: RIGHT})
     info = step(spec, cfg, state, moves(STAY, STAY))
     assert info.pushed[0, 0]
     assert list(state.pos[0]) == [1, 2]
@@ -198,7 +195,7 @@ def test_chain_behind_a_contest_follows_its_front_agent(line_map):
     for seed in range(40):
         new_pos, collided, events = resolve_collisions(
             line_map, np.array([[1, 2, 4]]), np.array([[2, 3, 3]]), np.ones((1, 3), bool),
-            np.random.default_rng(seed))
+            np.random.default_rng(seed).random((1, 3)))
         outcomes.add(tuple(new_pos[0]))
         assert list(collided[0]) == [False, True, True] and events[0] == 1
     assert outcomes == {(2, 3, 4), (1, 2, 3)}
@@ -207,10 +204,9 @@ def test_chain_behind_a_contest_follows_its_front_agent(line_map):
 def test_push_into_a_wall_leaves_the_agent_in_place(non_square_map):
     spec = non_square_map                          # (0, 3) is an obstacle
     cfg = deterministic_config(max_agents=1)
-    seed = seed_drawing_pushes(1, {0: RIGHT})
     state = place(spec, cfg, [(0, 2)])
     state.p_dyn[0, 0] = 1.0
-    state.rng = np.random.default_rng(seed)
+    state.streams = streams_drawing_pushes(1, {0: RIGHT})
     info = step(spec, cfg, state, moves(LEFT))     # the push replaces the chosen move
     assert info.pushed[0, 0]
     assert state.pos[0, 0] == cell(spec, 0, 2)
@@ -220,10 +216,9 @@ def test_push_into_a_wall_leaves_the_agent_in_place(non_square_map):
 def test_push_out_of_the_grid_leaves_the_agent_in_place(non_square_map):
     spec = non_square_map
     cfg = deterministic_config(max_agents=1)
-    seed = seed_drawing_pushes(1, {0: UP})
     state = place(spec, cfg, [(0, 5)])
     state.p_dyn[0, 0] = 1.0
-    state.rng = np.random.default_rng(seed)
+    state.streams = streams_drawing_pushes(1, {0: UP})
     step(spec, cfg, state, moves(DOWN))
     assert state.pos[0, 0] == cell(spec, 0, 5)
 
@@ -234,7 +229,7 @@ def test_push_direction_is_the_drawn_one(non_square_map):
     for direction, expected in [(UP, (0, 4)), (DOWN, (2, 4)), (LEFT, (1, 3)), (RIGHT, (1, 5))]:
         state = place(spec, cfg, [(1, 4)])
         state.p_dyn[0, 0] = 1.0
-        state.rng = np.random.default_rng(seed_drawing_pushes(1, {0: direction}))
+        state.streams = streams_drawing_pushes(1, {0: direction})
         step(spec, cfg, state, moves(STAY))
         assert state.pos[0, 0] == cell(spec, *expected)
 
@@ -286,7 +281,7 @@ def test_pushed_arrival_on_the_station_does_not_swap(line_map):
     cfg = deterministic_config(max_agents=1)
     state = place(spec, cfg, [(0, 1)])
     state.p_dyn[0, 0] = 1.0
-    state.rng = np.random.default_rng(seed_drawing_pushes(1, {0: LEFT}))
+    state.streams = streams_drawing_pushes(1, {0: LEFT})
     info = step(spec, cfg, state, moves(RIGHT))
     assert state.pos[0, 0] == spec.station
     assert state.status[0, 0] == ACTIVE and not info.swap_started[0, 0]

@@ -11,6 +11,7 @@ import yaml
 from patrolsb3 import zoo
 from patrolsb3.commands import zoo as zoo_command
 from patrolsb3.core import load_map, make_config, protocol, reset_state
+from patrolsb3.core.streams import STREAMS_VERSION
 from patrolsb3.evaluate import run_episodes
 from patrolsb3.sb3 import make_vec_env
 from patrolsb3.sb3.maskable_recurrent_ppo import MaskableRecurrentPPO
@@ -346,9 +347,9 @@ def test_zoo_eval_rewrites_eval_json_with_intervals_and_the_card_shows_them(trai
     assert "| 1 | " in text and " [" in text.split("| 1 | ", 1)[1].split("\n")[0]   # intervals in the table
 
 
-def fake_seed_eval(folder, seed, values, episodes_kept=True, episodes=10):
+def fake_seed_eval(folder, seed, values, episodes_kept=True, episodes=10, draws=STREAMS_VERSION):
     """A seed folder with a stand-in model and an eval.json for n = 1 whose AVG^h episodes are
-    ``values`` (no per-episode figures when ``episodes_kept`` is False)."""
+    ``values`` (no per-episode figures when ``episodes_kept`` is False), evaluated under ``draws``."""
     import json
     path = folder / f"seed{seed}"
     path.mkdir(parents=True)
@@ -361,7 +362,7 @@ def fake_seed_eval(folder, seed, values, episodes_kept=True, episodes=10):
               "steps": 100, "seed": 0, "faults": [], "deterministic": True,
               "summary": {"avg_idleness": metric, "clean_episodes": [len(values)]}}
     (path / "eval.json").write_text(json.dumps({"episodes": episodes, "steps": 100, "seed": 0, "tests": 1,
-                                                "deterministic": True, "results": [result]}))
+                                                "deterministic": True, "draws": draws, "results": [result]}))
 
 
 def test_seeds_are_pooled_episode_by_episode_and_the_unusable_ones_named(tmp_path):
@@ -376,6 +377,7 @@ def test_seeds_are_pooled_episode_by_episode_and_the_unusable_ones_named(tmp_pat
     assert r["training_seeds"] == [0, 1] and r["unpooled_seeds"] == []
     assert s["mean"] == pytest.approx(np.concatenate([low, high]).mean())
     assert s["tests"] == pytest.approx([low.mean(), high.mean()]) and len(s["episodes"]) == 20
+    assert s["units"] == [pytest.approx(list(low)), pytest.approx(list(high))]      # each seed's episodes, for pairing
     # the interval spans the two seeds' spread, far wider than either seed's own
     assert s["ci95"][0] < 16 < s["ci95"][1] and s["ci95"][1] - s["ci95"][0] > 3
     assert r["summary"]["clean_episodes"] == [10, 10]
@@ -388,6 +390,9 @@ def test_seeds_are_pooled_episode_by_episode_and_the_unusable_ones_named(tmp_pat
     one = zoo.pooled_result("A", "rl-no-msg", 1, 10, 100, 0, zoo_dir=tmp_path)
     assert one["summary"]["avg_idleness"]["ci95"] == [10.0, 11.0] and one["training_seeds"] == [0]
     assert zoo.pooled_result("A", "rl-msg", 1, 20, 100, 0, zoo_dir=tmp_path) is None
+    # an eval.json of the draws from before paired episodes is not reused
+    fake_seed_eval(tmp_path / "A" / "rl-intention", 0, low, draws=None)
+    assert zoo.pooled_result("A", "rl-intention", 1, 10, 100, 0, zoo_dir=tmp_path) is None
 
 
 def test_cards_gather_each_entrys_listening_and_ablation_into_a_messages_page(trained, tmp_path):

@@ -32,9 +32,16 @@ import numpy as np
 from .config import EnvConfig
 from .maps import ACTION_NAMES, STAY, MapSpec
 from .masks import move_allowed, station_cells
-from .reward import (battery_reward, collision_reward, difference_reward, home_potential,
-                     normalised_idleness, team_patrol_reward)
+from .reward import (
+    battery_reward,
+    collision_reward,
+    difference_reward,
+    home_potential,
+    normalised_idleness,
+    team_patrol_reward,
+)
 from .state import ACTIVE, FAILED, SWAPPING, State
+from .streams import StepDraws
 
 
 class InvalidActionError(ValueError):
@@ -129,14 +136,14 @@ def _no_conflict(spec: MapSpec, pos: np.ndarray, target: np.ndarray, active: np.
 
 
 def resolve_collisions(spec: MapSpec, pos: np.ndarray, target: np.ndarray, active: np.ndarray,
-                       rng: np.random.Generator):
+                       tie_break: np.ndarray):
     """Apply the collision rule to simultaneous moves.
 
     Args:
         pos: (E, A) current cells.
         target: (E, A) cells the slots head for (their own cell when staying).
         active: (E, A) bool, slots on the grid.
-        rng: draws the winner of each contested cell.
+        tie_break: (E, A) uniforms; the highest mover into a contested cell wins it.
 
     Returns:
         new_pos (E, A), collided (E, A) bool, events (E,) int64.
@@ -158,7 +165,7 @@ def resolve_collisions(spec: MapSpec, pos: np.ndarray, target: np.ndarray, activ
             & (target[:, :, None] == target[:, None, :]) & ~on_station[:, :, None])  # (E, A, A)
     contender = same.sum(axis=2) >= 2
     if contender.any():
-        key = rng.random((E, A))
+        key = tie_break
         best = np.where(same, key[:, None, :], -1.0).max(axis=2)
         loser = contender & (key < best)
         lower = np.tril(np.ones((A, A), dtype=bool), -1)[None]           # j < i
@@ -197,7 +204,7 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
     Returns:
         A :class:`StepInfo`.
     """
-    rng = state.rng
+    draws = state.streams.step()      # every episode's draws of this step, whatever happens
     E, A = state.pos.shape
     acted = state.active                                                  # (E, A) a new array
     # 1. messages
@@ -213,15 +220,15 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
         home_scale = float(sum(spec.shape))
         phi_before = home_potential(spec.steps_home[pos], state.battery, cfg, home_scale)
     # 3. pushes by the environment
-    pushed = acted & (rng.random((E, A)) < state.p_dyn)
-    push_dir = rng.integers(0, 4, size=(E, A))
+    pushed = acted & (draws.push < state.p_dyn)
+    push_dir = draws.push_direction()
     target = spec.neighbour[pos, moves]                                     # (E, A)
     if pushed.any():
         target = np.where(pushed, spec.neighbour[pos, push_dir], target)
     # 4. collisions
-    new_pos, collided, collisions = resolve_collisions(spec, pos, target, acted, rng)
+    new_pos, collided, collisions = resolve_collisions(spec, pos, target, acted, draws.tie_break)
     # 5. battery
-    drain = rng.uniform(cfg.drain[0], cfg.drain[1], size=(E, A))
+    drain = draws.drain(cfg.drain[0], cfg.drain[1])
     if pushed.any():
         drain = np.where(pushed, drain * cfg.push_drain_factor, drain)
     state.battery = np.where(acted, state.battery - drain, state.battery)
@@ -246,7 +253,7 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
         state.status = np.where(swap_ended, ACTIVE, state.status).astype(np.int8, copy=False)
         state.battery = np.where(swap_ended, cfg.b_max, state.battery)
     arrived = acted & ~pushed & (new_pos != pos) & station_cells(spec)[new_pos]
-    durations = rng.integers(cfg.swap_time[0], cfg.swap_time[1] + 1, size=(E, A))
+    durations = draws.swap_time(cfg.swap_time[0], cfg.swap_time[1])
     if arrived.any():
         swap_battery = np.where(arrived, state.battery / cfg.b_max, np.nan)
         state.status = np.where(arrived, SWAPPING, state.status).astype(np.int8, copy=False)
@@ -260,7 +267,7 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
     if empty.any():
         battery_failed = acted & ~arrived & empty
         state.status = np.where(battery_failed, FAILED, state.status).astype(np.int8, copy=False)
-    fault_failed = _inject_faults(cfg, state, rng)
+    fault_failed = _inject_faults(cfg, state, draws)
     # an agent saved by its arrival on the station did not fail: it gets the low-battery penalty
     reward_battery = battery_reward(battery_left, cfg) if compute_reward else None
     if empty.any():
@@ -294,20 +301,20 @@ def step(spec: MapSpec, cfg: EnvConfig, state: State, moves: np.ndarray,
         terminated=(state.status >= FAILED).all(axis=1))   # every slot failed or absent (ABSENT > FAILED)
 
 
-def _inject_faults(cfg: EnvConfig, state: State, rng: np.random.Generator) -> np.ndarray:
+def _inject_faults(cfg: EnvConfig, state: State, draws: StepDraws) -> np.ndarray:
     """Fail agents by schedule (cfg.faults) and by chance (cfg.fault_prob). Returns (E, A) bool."""
     E, A = state.pos.shape
     failed = np.zeros((E, A), dtype=bool)
     if cfg.fault_prob <= 0 and not cfg.faults:
         return failed
     if cfg.fault_prob > 0:
-        failed |= (state.status == ACTIVE) & (rng.random((E, A)) < cfg.fault_prob)
+        failed |= (state.status == ACTIVE) & (draws.chance_fault < cfg.fault_prob)
     for fault_step, k in cfg.faults:
         hit = state.t == fault_step                                        # (E,)
         if not hit.any():
             continue
         alive = (state.status == ACTIVE) | (state.status == SWAPPING)
-        key = np.where(alive, rng.random((E, A)), np.inf)
+        key = np.where(alive, draws.fault_order, np.inf)
         rank = np.argsort(np.argsort(key, axis=1), axis=1)                 # 0 = chosen first
         failed |= hit[:, None] & alive & (rank < k)
     state.status = np.where(failed, FAILED, state.status).astype(np.int8)

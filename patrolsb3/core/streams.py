@@ -5,7 +5,7 @@ Every episode of a batch has streams of its own, derived from the batch's seed a
 episode's id (numpy ``SeedSequence`` spawn keys), never from its position in the batch:
 
 - **start** (key ``(id, 0)``): the agents' start vertices, starting batteries and push
-  probabilities, drawn once for all ``max_agents`` slots;
+  probabilities, drawn once for :data:`STREAM_SLOTS` slots (or ``max_agents`` if more);
 - **world** (key ``(id, 1)``): what the environment does each step, for every slot whether it
   is deployed, acting or not: whether a push happens and its direction, the battery drain, the
   hot-swap time, a chance fault and the order of scheduled faults (:data:`WORLD_DRAWS` uniforms
@@ -26,6 +26,12 @@ from __future__ import annotations
 
 import numpy as np
 
+STREAMS_VERSION = "per-episode-1"
+"""Which draws an episode meets: results evaluated under other streams (before this module, one
+generator for the whole batch) are not reused for, nor paired with, these."""
+STREAM_SLOTS = 16
+"""Slots drawn for per step and at the start, whatever ``max_agents`` (more if it is larger), so
+that slot ``j`` draws alike in a 5-slot evaluation and a 12-slot model's."""
 WORLD_DRAWS = 6
 """Uniforms per slot per step in the world stream, in this order: push, push direction, drain,
 swap time, chance fault, scheduled-fault order (:class:`StepDraws`)."""
@@ -81,17 +87,18 @@ class EpisodeStreams:
     Args:
         entropy: the batch's seed (an int), or None for fresh entropy.
         episode_ids: (E,) int, each episode's id; episodes with the same seed and id draw the same.
-        n_slots: slots per episode (``max_agents``).
+        n_slots: slots per episode (``max_agents``); :data:`STREAM_SLOTS` or more are drawn for.
     """
 
     def __init__(self, entropy, episode_ids, n_slots: int):
         self.entropy = np.random.SeedSequence(entropy).entropy
         self.ids = np.asarray(episode_ids, dtype=np.int64).copy()           # (E,)
         self.n_slots = int(n_slots)
+        self.drawn_slots = max(self.n_slots, STREAM_SLOTS)
         E, A = len(self.ids), self.n_slots
         self._world = [self._generator(i, WORLD) for i in self.ids]
         self._ties = [self._generator(i, TIE_BREAK) for i in self.ids]
-        self._world_block = np.empty((BLOCK, E, A, WORLD_DRAWS))               # (BLOCK, E, A, W)
+        self._world_block = np.empty((BLOCK, E, A, WORLD_DRAWS))               # (BLOCK, E, A, W) slots in use
         self._tie_block = np.empty((BLOCK, E, A))                              # (BLOCK, E, A)
         self._next = BLOCK                                                     # step of the block to read
 
@@ -102,10 +109,10 @@ class EpisodeStreams:
         """The start draws of some episodes (all by default): uniforms (k, V) ranking the start
         vertices, (k, A) for the starting battery and (k, A) for the push probability."""
         ids = self.ids if rows is None else self.ids[np.asarray(rows)]
-        draws = [self._generator(i, START).random(n_vertices + 2 * self.n_slots) for i in ids]
-        block = np.array(draws).reshape(len(ids), -1)                           # (k, V + 2A)
-        V, A = n_vertices, self.n_slots
-        return block[:, :V], block[:, V:V + A], block[:, V + A:]
+        V, A, S = n_vertices, self.n_slots, self.drawn_slots
+        draws = [self._generator(i, START).random(V + 2 * S) for i in ids]
+        block = np.array(draws).reshape(len(ids), -1)                           # (k, V + 2S)
+        return block[:, :V], block[:, V:V + A], block[:, V + S:V + S + A]
 
     def step(self) -> StepDraws:
         """The next step's draws of every episode."""
@@ -118,9 +125,9 @@ class EpisodeStreams:
         return StepDraws(self._world_block[t], self._tie_block[t])
 
     def _fill(self, e: int, start: int) -> None:
-        steps = BLOCK - start
-        self._world_block[start:, e] = self._world[e].random((steps, self.n_slots, WORLD_DRAWS))
-        self._tie_block[start:, e] = self._ties[e].random((steps, self.n_slots))
+        steps, A = BLOCK - start, self.n_slots        # every drawn slot is drawn; the ones in use kept
+        self._world_block[start:, e] = self._world[e].random((steps, self.drawn_slots, WORLD_DRAWS))[:, :A]
+        self._tie_block[start:, e] = self._ties[e].random((steps, self.drawn_slots))[:, :A]
 
     def restart(self, rows) -> None:
         """New episodes in ``rows`` (a parallel episode of training that ended): each takes the

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.metrics import idleness_lower_bounds
+from ..core.streams import STREAMS_VERSION
 from ..evaluate import run_episodes
 from ..names import strategy_name
 from ..outputs import write_json
@@ -43,7 +44,9 @@ def write_zoo_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0
     cfg = evaluation_config(policy, steps)
     per_size = episodes * tests
     team = np.repeat(np.arange(1, max_agents + 1), per_size)                # (max_agents * per_size,)
+    ids = np.tile(np.arange(per_size), max_agents)                          # episode j of every size: id j
     per_episode = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, progress=progress,
+                               episode_ids=ids,
                                desc=f"zoo {config['map']}/{config['variant']} n=1..{max_agents}",
                                deterministic=deterministic)
     strategy = strategy_name(config["variant"], guard=policy.cfg.return_guard)
@@ -53,12 +56,12 @@ def write_zoo_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0
         part = {k: v[rows] for k, v in per_episode.items() if isinstance(v, np.ndarray)}
         results.append({"strategy": strategy, "map": config["map"], "n_agents": n, "episodes": episodes,
                         "tests": tests, "steps": steps, "seed": seed, "faults": [],
-                        "deterministic": bool(deterministic), "env": cfg.to_dict(),
+                        "deterministic": bool(deterministic), "env": cfg.to_dict(), "draws": STREAMS_VERSION,
                         "policy_settings": policy.env_settings(),
                         "summary": summarize(part, tests),
                         "bounds": idleness_lower_bounds(policy.spec.n_vertices, n, steps)})
     out = {"map": config["map"], "strategy": strategy, "episodes": episodes, "tests": tests,
-           "steps": steps, "seed": seed, "deterministic": bool(deterministic),
-           "note": "all team sizes stepped in one batch; episodes of size n are rows n-1 of the batch",
+           "steps": steps, "seed": seed, "deterministic": bool(deterministic), "draws": STREAMS_VERSION,
+           "note": "all team sizes stepped in one batch; episode j of every size has id j (paired draws)",
            "results": results}
     return write_json(ZooEntry(folder).evaluation_file, out, indent=2)

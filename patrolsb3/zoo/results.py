@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.streams import STREAMS_VERSION
 from ..names import strategy_name
 from ..outputs import read_eval_file
 from ..runs import ZooEntry
@@ -21,7 +22,8 @@ def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
         return None
     data = read_eval_file(path)
     if (data.get("episodes"), data.get("steps"), data.get("seed"), data.get("tests"),
-            data.get("deterministic", True)) != (episodes, steps, seed, tests, deterministic):
+            data.get("deterministic", True), data.get("draws")) != (episodes, steps, seed, tests, deterministic,
+                                                                     STREAMS_VERSION):
         return None
     found = next((r for r in data.get("results", []) if r["n_agents"] == n_agents), None)
     return None if found is None else {**found, "strategy": strategy_name(variant, guard)}
@@ -37,7 +39,8 @@ def pooled_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
     apart give a wide interval that contains both. A rate (the battery failure rate) pools the
     seeds' episodes and takes the exact binomial interval (:func:`patrolsb3.stats.rate_interval`):
     with three seeds of 10 episodes, a t over three rates of 0 would say [0, 0].
-    ``summary[metric]["tests"]`` holds the seeds' own means, ``["episodes"]`` every episode. With
+    ``summary[metric]["tests"]`` holds the seeds' own means, ``["episodes"]`` every episode and
+    ``["units"]`` each seed's episodes (what :mod:`patrolsb3.claims` pairs episode by episode). With
     one usable seed this is that seed's result unchanged (its intervals are over its episodes:
     a figure, not a verdict; ``claims`` tests no cell below three seeds).
 
@@ -73,7 +76,8 @@ def pooled_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
                 mean = float(np.mean(finite_means)) if finite_means else float("nan")
                 ci = seed_interval(seed_means)
             summary[metric] = {"mean": mean, "std": float(np.nanstd(seed_means)), "tests": seed_means,
-                               "ci95": ci, "episodes": [float(v) for v in pooled]}
+                               "ci95": ci, "episodes": [float(v) for v in pooled],
+                               "units": [list(r["summary"][metric]["episodes"]) for _, r in usable]}
         elif metric == "clean_episodes":
             summary[metric] = [int(sum(r["summary"][metric])) for _, r in usable]
         else:

@@ -69,7 +69,9 @@ def validate_policy(policy, team_sizes=(1, 3, 5), episodes: int = 4, steps: int 
     checkpoint or a zoo entry): {"failures", "bf_rate", "avg_idleness", "swap_battery"}."""
     cfg = evaluation_config(policy, steps)
     team = np.repeat(np.asarray(team_sizes, dtype=np.int64), episodes)          # (E,)
-    result = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, deterministic=True)
+    ids = np.tile(np.arange(episodes), len(team_sizes))                         # paired across sizes
+    result = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, deterministic=True,
+                          episode_ids=ids)
     swap = result["swap_battery"]
     return {"failures": float(result["battery_failures"].mean()), "bf_rate": float(result["failed"].mean()),
             "avg_idleness": float(result["avg_idleness"].mean()),
