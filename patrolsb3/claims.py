@@ -198,13 +198,12 @@ def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, 
         figure += " (" + "; ".join(f"by {LABEL.get(r, r)} in {len(c)}: {', '.join(c)}" for r, c in beaten_by.items()) + ")"
     figure += f"; level in {level}"
     example = None
-    if lost:
-        (cell, r), d = next(iter(sorted(lost.items())))
-        example = f"map {_where(cell)}: {LABEL.get(who, who)} - {LABEL.get(r, r)} = {d.text()} over {d.unit}"
-    elif won:
-        cell, r = sorted(won)[0]
-        d = next(d for c, rr, d in tested if (c, rr) == (cell, r))
-        example = f"map {_where(cell)}: {LABEL.get(who, who)} - {LABEL.get(r, r)} = {d.text()} over {d.unit}"
+    if lost or won:          # one cell: both figures with their intervals, and the paired difference
+        (cell, r), d = next(iter(sorted(lost.items()))) if lost else next(
+            ((c, rr), d) for c, rr, d in tested if (c, rr) == sorted(won)[0])
+        mine, theirs = (figures[(*cell, s, metric)] for s in (who, r))
+        example = (f"map {_where(cell)}: {LABEL.get(who, who)} {mine.text()} vs {LABEL.get(r, r)} {theirs.text()}, "
+                   f"paired difference {d.text()} over {d.unit}")
     figure += _untested_and_example(unmeasured, too_few, example)
     verdict = FAILS if lost else HOLDS if wins == compared else OPEN
     return {"verdict": verdict, "figure": figure, "cells": compared, "unmeasured": unmeasured}

@@ -48,8 +48,8 @@ def check_output_file(path, argument: str, inputs=()) -> Path:
     return path
 
 
-INPUT_NAMES = (ComparisonFolder.RESULTS_CSV, ComparisonFolder.RESULTS_JSON, ZooEntry.EVALUATION, RunFolder.CONFIG,
-               RunFolder.CURVE)
+INPUT_NAMES = (ComparisonFolder.RESULTS_CSV, ComparisonFolder.EPISODES_CSV, ComparisonFolder.RESULTS_JSON,
+               ZooEntry.EVALUATION, RunFolder.CONFIG, RunFolder.CURVE)
 """Files a command reads out of the folder it is given (a comparison folder, a run or an entry)."""
 
 

@@ -8,6 +8,7 @@ validation. MAP VARIANT means the paper's setting; ``--guarded`` the entries beh
 guard, ``--seed-of-entry K`` one training seed."""
 import json
 import math
+from pathlib import Path
 
 from ..ablation import ablation_table, message_ablation
 from ..listening import listening
@@ -120,13 +121,12 @@ def add_arguments(parser):
 
 
 def relative_path(path) -> str:
-    """``path`` relative to the working folder when it lies under it, else its last three parts."""
-    from pathlib import Path
+    """``path`` relative to the working folder when it lies under it, else in full."""
     path = Path(path).resolve()
     try:
         return str(path.relative_to(Path.cwd().resolve()))
     except ValueError:
-        return str(Path(*path.parts[-3:]))
+        return str(path)
 
 
 def headline(entry: dict) -> str:
@@ -260,7 +260,7 @@ def export_and_evaluate(args) -> int:
         lock.release()
     print(f"exported to {entry}")
     if not args.no_eval:
-        print(f"evaluation written to {entry / 'eval.json'}")
+        print(f"evaluation written to {ZooEntry(entry).evaluation_file}")
     return 0
 
 
