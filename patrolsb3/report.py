@@ -157,7 +157,7 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
         spread = ("mean +- std over tests" if r0["tests"] > 1 else "one test") + \
             ", with a 95 % bootstrap interval over the episodes in brackets where the result has one " \
             "(results computed before 2026-12-02 have none; a zoo column that pools several training " \
-            "seeds bootstraps over all their episodes, see the notes below)"
+            "seeds: Student's t over the seeds' means, see the notes below)"
         md += [f"{r0['tests']} test(s) x {r0['episodes']} episodes x {r0['steps']} steps per "
                f"(map, strategy, team size); {spread}. Idleness and collision figures "
                f"average over episodes without a battery failure (counts in results.csv). The best "
@@ -275,8 +275,8 @@ LEARNED_MARKERS = {"rl-msg": "s", "rl-no-msg": "^", "rl-intention": "D"}
 """Markers of the learned variants' lines (a heuristic's is a circle), so that they are told
 apart without colour."""
 
-ERROR_BAR_CAPTION = ("error bars: 95 % interval of the mean over the episodes (zoo columns: the episodes of "
-                     "every training seed pooled); exact binomial for the battery failure rate")
+ERROR_BAR_CAPTION = ("error bars: 95 % interval of the mean (a heuristic's over its episodes; a zoo column of "
+                     "several training seeds: over the seeds' means); exact binomial for the battery failure rate")
 
 
 def plot_map(results: list[dict], map_name: str, path) -> Path:
