@@ -161,7 +161,9 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
         md += [f"{r0['tests']} test(s) x {r0['episodes']} episodes x {r0['steps']} steps per "
                f"(map, strategy, team size); {spread}. Idleness and collision figures "
                f"average over episodes without a battery failure (counts in results.csv). The best "
-               f"(lowest) value of each row is in bold.", ""]
+               f"(lowest) value of each row is in bold, ties all bold, a row of equal values plain; BLv "
+               f"(battery at swap) has no best: a higher level is safer, a lower one uses more of each "
+               f"battery, and the paper asks only that it stay above b_l.", ""]
         learned = [r for r in results if is_learned(r.get("strategy", ""))]
         if learned:
             sampled = any(r.get("deterministic", True) is False for r in learned)
