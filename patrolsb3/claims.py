@@ -35,11 +35,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .names import display_name
+from .names import VARIANT_NAMES, display_name, strategy_name
 from .runs import ComparisonFolder, read_curve
 from .stats import MIN_SEEDS, RATE_METRICS, Difference, holm, paired_difference, seed_interval, testable
 
-MSG, NOMSG, INTENTION = "zoo:rl-msg", "zoo:rl-no-msg", "zoo:rl-intention"
+MSG, NOMSG, INTENTION = (strategy_name(variant) for variant in VARIANT_NAMES)
 LEARNED = (MSG, NOMSG, INTENTION)
 HEURISTICS = ("CR", "PART", "SEBS")
 PAPER_STRATEGIES = HEURISTICS + LEARNED
@@ -319,7 +319,7 @@ def training_reward(curves: dict, fraction: float = 0.2) -> dict:
             if not tails:
                 continue
             low, high = seed_interval(tails)
-            figures[(m, 0, f"zoo:{variant}", "training_reward")] = Figure(
+            figures[(m, 0, strategy_name(variant), "training_reward")] = Figure(
                 sum(tails) / len(tails), low, high, testable=len(tails) >= MIN_SEEDS,
                 units=tuple((t,) for t in tails))       # one value a seed: compared by Welch's t over seeds
     return lowest(figures, MSG, LEARNED, "training_reward", highest=True)

@@ -23,7 +23,7 @@ import numpy as np
 from .claims import PAIRED_METRICS, claims, claims_table, read_figures
 from .core.streams import STREAMS_VERSION
 from .learning_curves import plot_learning_curves
-from .names import display_name, is_learned
+from .names import CSV_COLUMNS, VARIANT_NAMES, display_name, is_learned, strategy_name
 from .runs import ComparisonFolder
 
 PAPER_TABLES = {"BF": "battery_failure_rate", "BLv": "swap_battery_pct", "MAX": "max_idleness",
@@ -31,10 +31,9 @@ PAPER_TABLES = {"BF": "battery_failure_rate", "BLv": "swap_battery_pct", "MAX": 
 """Paper table suffix -> metric key of the summary."""
 PAPER_COLUMNS = ("CR", "PART", "SEBS", "INTENTION", "NOMSG", "MSG")
 EXTRA_COLUMNS = ("RANDOM", "CYCLIC")
-ZOO_COLUMNS = {"INTENTION": "zoo:rl-intention", "NOMSG": "zoo:rl-no-msg", "MSG": "zoo:rl-msg"}
+ZOO_COLUMNS = {column: strategy_name(CSV_COLUMNS[column]) for column in ("INTENTION", "NOMSG", "MSG")}
 """Paper column -> strategy name that fills it (the zoo entries in the paper's setting)."""
-GUARDED_COLUMNS = {"INTENTION-GUARDED": "zoo:rl-intention:guarded", "NOMSG-GUARDED": "zoo:rl-no-msg:guarded",
-                   "MSG-GUARDED": "zoo:rl-msg:guarded"}
+GUARDED_COLUMNS = {f"{column}-GUARDED": strategy_name(CSV_COLUMNS[column], guard=True) for column in ZOO_COLUMNS}
 """Extra columns of the entries behind the return guard, present only when a comparison has them."""
 LABELS = {"avg_idleness": "AVG^h", "max_idleness": "MAX^h", "worst_idleness": "worst idleness",
           "std_idleness": "std across vertices", "collisions": "collisions / episode",
@@ -331,7 +330,7 @@ ZOO_TABLE_METRICS = (("avg_idleness_all", "AVG^h (all)", 1), ("max_idleness_all"
 """Columns of the zoo README's tables: (metric, header, digits)."""
 
 
-def zoo_tables(results_csv, strategies=("zoo:rl-msg", "zoo:rl-no-msg", "zoo:rl-intention", "CR", "PART",
+def zoo_tables(results_csv, strategies=(*map(strategy_name, VARIANT_NAMES), "CR", "PART",
                                         "SEBS", "CYCLIC")) -> str:
     """Markdown tables, one per map, of zoo models against the heuristics, read from a
     comparison's ``results.csv``: rows (n, strategy), columns :data:`ZOO_TABLE_METRICS`.
