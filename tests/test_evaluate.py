@@ -9,7 +9,6 @@ from patrolsb3 import cli, zoo
 from patrolsb3.commands.evaluate import parse_faults
 from patrolsb3.core import load_map, make_config
 from patrolsb3.evaluate import evaluate, load_policy, run_episodes
-from patrolsb3.summary import summarize
 
 
 def test_parse_faults():
@@ -17,28 +16,6 @@ def test_parse_faults():
     for bad in ["12x", "1:2:3", "5:0", "-1:1"]:
         with pytest.raises(ValueError, match="bad --faults"):
             parse_faults([bad])
-
-
-def test_summarize_over_tests_by_hand():
-    per_episode = {
-        "avg_idleness": np.array([10.0, 20.0, 30.0, 50.0]),
-        "max_idleness": np.array([1.0, 2.0, 3.0, 5.0]),
-        "worst_idleness": np.zeros(4), "std_idleness": np.zeros(4),
-        "collisions": np.array([1.0, 3.0, 5.0, 7.0]),
-        "battery_failures": np.array([0.0, 2.0, 0.0, 0.0]),
-        "failed": np.array([False, True, False, False]),
-        "swap_battery": np.array([0.2, np.nan, 0.3, 0.1]),
-        "swaps": np.array([1, 0, 2, 2]),
-    }
-    s = summarize(per_episode, tests=2)
-    # test 0: only episode 0 is clean; test 1: both
-    assert s["avg_idleness"]["tests"] == [10.0, 40.0]
-    assert s["avg_idleness"]["mean"] == 25.0 and s["avg_idleness"]["std"] == 15.0
-    assert s["collisions"]["tests"] == [1.0, 6.0]
-    assert s["battery_failure_rate"]["tests"] == [0.5, 0.0]
-    assert s["battery_failures"]["tests"] == [1.0, 0.0]
-    assert s["swap_battery_pct"]["tests"] == pytest.approx([20.0, 20.0])
-    assert s["clean_episodes"] == [1, 2]
 
 
 def test_evaluate_with_fault_splits_segments():
@@ -180,18 +157,3 @@ def test_compare_asks_for_a_default_seed_before_running(tmp_path, monkeypatch, c
         assert len(err.splitlines()) == 1 and not (tmp_path / "o").exists()
 
 
-def test_summary_also_averages_over_every_episode():
-    per_episode = {"failed": np.array([True, False, False, True]),
-                   "battery_failures": np.array([1, 0, 0, 2]), "swaps": np.array([0, 1, 1, 0]),
-                   "swap_battery": np.array([np.nan, 0.2, 0.3, np.nan])}
-    for name in ("avg_idleness", "max_idleness", "worst_idleness", "std_idleness", "collisions"):
-        per_episode[name] = np.array([10.0, 2.0, 4.0, 20.0])
-    s = summarize(per_episode, tests=2)
-    assert s["avg_idleness"]["tests"] == [2.0, 4.0]              # clean episodes only
-    assert s["avg_idleness_all"]["tests"] == [6.0, 12.0]         # every episode
-    # every episode's value is kept in episode order (NaN where the figure does not count it), so
-    # that training seeds can be pooled and two strategies paired episode by episode
-    assert s["avg_idleness"]["episodes"] == pytest.approx([np.nan, 2.0, 4.0, np.nan], nan_ok=True)
-    assert s["avg_idleness_all"]["episodes"] == [10.0, 2.0, 4.0, 20.0]
-    assert s["swap_battery_pct"]["episodes"] == pytest.approx([np.nan, 20.0, 30.0, np.nan], nan_ok=True)
-    assert s["avg_idleness"]["ci95"][0] >= 2.0 and s["avg_idleness"]["ci95"][1] <= 4.0

@@ -35,16 +35,6 @@ def test_a_stored_rate_is_read_back_with_its_exact_interval():
     assert summary["avg_idleness"]["ci95"] == [4.0, 6.0]                      # a mean's stays as stored
 
 
-def test_an_evaluation_summarises_its_failure_rate_exactly():
-    from patrolsb3.summary import summarize
-    per_episode = {"failed": np.zeros(20, dtype=bool), "battery_failures": np.zeros(20), "swaps": np.zeros(20),
-                   "swap_battery": np.full(20, np.nan),
-                   **{k: np.ones(20) for k in ("avg_idleness", "max_idleness", "worst_idleness",
-                                               "std_idleness", "collisions")}}
-    rate = summarize(per_episode, tests=1)["battery_failure_rate"]
-    assert rate["mean"] == 0.0 and rate["ci95"][1] == pytest.approx(0.1684, abs=1e-3)   # 0 in 20
-
-
 def test_an_interval_over_seeds_contains_the_seed_means_of_a_bimodal_case():
     from patrolsb3.stats import seed_interval
     seeds = [425.1, 424.5, 329.9]                      # A, rl-msg, one agent, MAX^h
