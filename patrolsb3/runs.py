@@ -333,7 +333,7 @@ class RunFolder:
         """``model.zip`` when the run finished, else its newest valid checkpoint, else None."""
         return self.model_file if self.model_file.is_file() else self.newest_checkpoint()
 
-    def snapshot(self, dest, keep: int = 1) -> Path:
+    def snapshot(self, dest, keep: int = 1, milestones=()) -> Path:
         """Copy what ``--resume`` needs into a new run folder ``dest``: the newest valid checkpoint
         (the model with its optimizer state) and its reward statistics, config.yml, command.txt
         and the CSV records; TensorBoard logs and, unless ``keep`` asks for them, older
@@ -346,6 +346,8 @@ class RunFolder:
                 (default 1, all that ``--resume`` reads). A run stopped near its end keeps more,
                 so that choosing a checkpoint by validation (``zoo validate --last 6``) still
                 sees those written before the stop.
+            milestones: agent-steps whose checkpoints are kept too, where the run has them (a run
+                evaluated along the way, e.g. issue 43's E2 at the zoo's budget of 16 M and at 32 M).
 
         Returns:
             The newest checkpoint copied, in ``dest``.
@@ -363,10 +365,11 @@ class RunFolder:
             raise FileExistsError(
                 f"{self.path}: finished (model.zip), nothing to resume; a snapshot keeps only the newest checkpoints, "
                 "so validate and export the run (zoo/finish_paper_run.sh) while its checkpoints are there")
-        kept = [p for p in reversed(self.checkpoints()) if is_valid_model_file(p)][:keep]
-        # kept: newest first, at most `keep` paths
-        if not kept:
+        valid = [p for p in reversed(self.checkpoints()) if is_valid_model_file(p)]     # newest first
+        if not valid:
             raise FileNotFoundError(f"{self.path}: no valid checkpoint to snapshot")
+        wanted = {int(m) for m in milestones}
+        kept = valid[:keep] + [p for p in valid[keep:] if model_steps(p) in wanted]
         # a run that normalises its rewards is resumed with the statistics beside its checkpoint
         normalized = not self.config_file.is_file() or bool(
             (self.read_config().get("hyperparams") or {}).get("normalize_reward", True))

@@ -90,6 +90,9 @@ def test_a_snapshot_keeps_the_newest_k_valid_checkpoints_when_asked(tmp_path):
     assert not (tmp_path / "snap2").exists()                        # refused before any copy
     run.config_file.write_text("map: A\nhyperparams: {normalize_reward: false}\n")    # no statistics to carry
     assert run.snapshot(tmp_path / "snap2") == RunFolder(tmp_path / "snap2").checkpoint_file(1600)
+    milestone = run.snapshot(tmp_path / "milestone", milestones=(400, 1200, 5000))   # 5000: not there
+    assert [p.name for p in RunFolder(tmp_path / "milestone").checkpoints()] == \
+        [f"model_{s}_steps.zip" for s in (400, 1200, 1600)] and milestone.name == "model_1600_steps.zip"
     for bad in (0, -1, 1.5, True):
         with pytest.raises(ValueError, match="keep: "):
             run.snapshot(tmp_path / "snap3", keep=bad)
