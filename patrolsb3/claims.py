@@ -199,8 +199,8 @@ def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, 
     figure += f"; level in {level}"
     example = None
     if lost or won:          # one cell: both figures with their intervals, and the paired difference
-        (cell, r), d = next(iter(sorted(lost.items()))) if lost else next(
-            ((c, rr), d) for c, rr, d in tested if (c, rr) == sorted(won)[0])
+        shown = min(lost) if lost else min(won)
+        (cell, r), d = shown, next(d for c, rr, d in tested if (c, rr) == shown)
         mine, theirs = (figures[(*cell, s, metric)] for s in (who, r))
         example = (f"map {_where(cell)}: {LABEL.get(who, who)} {mine.text()} vs {LABEL.get(r, r)} {theirs.text()}, "
                    f"paired difference {d.text()} over {d.unit}")

@@ -44,6 +44,17 @@ def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0, device: str 
     return strategies.get(name, spec, n_agents, cfg=cfg, seed=seed)
 
 
+def team_batch(team_sizes, episodes: int) -> tuple[np.ndarray, np.ndarray]:
+    """One batch of ``episodes`` episodes for each team size, paired: episode j of every size has
+    the id j, so it meets the same draws (:mod:`patrolsb3.core.streams`).
+
+    Returns:
+        team (len(team_sizes) * episodes,) int64 team size of each episode, and its episode ids.
+    """
+    sizes = np.asarray(team_sizes, dtype=np.int64)
+    return np.repeat(sizes, episodes), np.tile(np.arange(episodes), len(sizes))
+
+
 def run_episodes(policy, spec, cfg, n_agents: int, n_envs: int, seed: int = 0, progress=False,
                  desc: str = "", deterministic: bool = True, episode_ids=None) -> dict:
     """Run ``n_envs`` episodes of ``cfg.episode_steps`` steps together.

@@ -157,3 +157,9 @@ def test_compare_asks_for_a_default_seed_before_running(tmp_path, monkeypatch, c
         assert len(err.splitlines()) == 1 and not (tmp_path / "o").exists()
 
 
+
+
+def test_a_batch_of_team_sizes_pairs_episode_j_of_every_size():
+    from patrolsb3.evaluate import team_batch
+    team, ids = team_batch([1, 3, 5], 2)
+    assert team.tolist() == [1, 1, 3, 3, 5, 5] and ids.tolist() == [0, 1, 0, 1, 0, 1]

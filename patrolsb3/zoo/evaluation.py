@@ -8,7 +8,7 @@ import numpy as np
 
 from ..core.metrics import idleness_lower_bounds
 from ..core.streams import STREAMS_VERSION
-from ..evaluate import run_episodes
+from ..evaluate import run_episodes, team_batch
 from ..names import strategy_name
 from ..outputs import write_json
 from ..runs import ZooEntry
@@ -43,8 +43,7 @@ def write_zoo_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0
     max_agents = policy.cfg.max_agents
     cfg = evaluation_config(policy, steps)
     per_size = episodes * tests
-    team = np.repeat(np.arange(1, max_agents + 1), per_size)                # (max_agents * per_size,)
-    ids = np.tile(np.arange(per_size), max_agents)                          # episode j of every size: id j
+    team, ids = team_batch(range(1, max_agents + 1), per_size)              # (max_agents * per_size,) each
     per_episode = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, progress=progress,
                                episode_ids=ids,
                                desc=f"zoo {config['map']}/{config['variant']} n=1..{max_agents}",

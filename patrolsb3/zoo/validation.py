@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ..evaluate import run_episodes
+from ..evaluate import run_episodes, team_batch
 from ..runs import RunFolder, is_valid_model_file, model_steps, write_atomically
 from .folders import DEFAULT_FILE, ZooError, seeds, variant_folder
 from .policy import evaluation_config, load_checkpoint, load_entry
@@ -68,8 +68,7 @@ def validate_policy(policy, team_sizes=(1, 3, 5), episodes: int = 4, steps: int 
     """The figures of :func:`validate` for a loaded :class:`~patrolsb3.zoo.ZooPolicy` (a
     checkpoint or a zoo entry): {"failures", "bf_rate", "avg_idleness", "swap_battery"}."""
     cfg = evaluation_config(policy, steps)
-    team = np.repeat(np.asarray(team_sizes, dtype=np.int64), episodes)          # (E,)
-    ids = np.tile(np.arange(episodes), len(team_sizes))                         # paired across sizes
+    team, ids = team_batch(team_sizes, episodes)                                # (E,) each, paired across sizes
     result = run_episodes(policy, policy.spec, cfg, team, len(team), seed=seed, deterministic=True,
                           episode_ids=ids)
     swap = result["swap_battery"]

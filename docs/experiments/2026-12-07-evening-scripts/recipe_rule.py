@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from patrolsb3 import zoo
-from patrolsb3.evaluate import run_episodes
+from patrolsb3.evaluate import run_episodes, team_batch
 
 COST = {"E0": 0, "E1": 0, "E2": 1}       # the rule's order of cost (E0 = E1 < E2)
 VALIDATION_SEED = 7
@@ -37,8 +37,7 @@ def candidate_figures(path: Path, episodes: int, steps: int) -> dict:
     """The rule's three figures for one model, on the validation seed."""
     policy = zoo.load_checkpoint(path) if path.suffix == ".zip" else zoo.load_entry(path)
     cfg = zoo.evaluation_config(policy, steps)
-    team = np.repeat(np.arange(1, 6), episodes)                              # (5 * episodes,)
-    ids = np.tile(np.arange(episodes), 5)                                    # episode j of every size paired
+    team, ids = team_batch(range(1, 6), episodes)                            # (5 * episodes,) each, paired
     out = run_episodes(policy, policy.spec, cfg, team, len(team), seed=VALIDATION_SEED, episode_ids=ids)
     big = team >= 3
     clean = big & ~out["failed"]
