@@ -1,11 +1,11 @@
 """The learning variants of the paper: same network and budget, only the message channel differs."""
 from __future__ import annotations
 
-VARIANTS = {
-    "rl-msg": {"comm": "learned"},         # RIAL: learned 16-symbol messages
-    "rl-no-msg": {"comm": "none"},         # positions only, no message channel
-    "rl-intention": {"comm": "intention"},  # each agent's intended move, a fixed meaning
-}
+from ..names import VARIANT_NAMES
+
+# in the order of VARIANT_NAMES (rl-msg, rl-no-msg, rl-intention): RIAL's learned 16-symbol
+# messages; positions only, no message channel; each agent's intended move, a fixed meaning
+VARIANTS = dict(zip(VARIANT_NAMES, ({"comm": "learned"}, {"comm": "none"}, {"comm": "intention"}), strict=True))
 """Variant name -> environment config overrides (:class:`patrolsb3.core.config.EnvConfig`)."""
 
 
