@@ -84,6 +84,17 @@ def read_config(path: Path) -> dict:
     return config
 
 
+def recorded_path(path) -> str:
+    """How a record (config.yml, a command's output) names a file: relative to the working
+    directory when it lies under it (a run started from the repository root names its source as
+    ``runs/...``, no path of this machine), else resolved and absolute."""
+    path = Path(path)
+    try:
+        return str(path.resolve().relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(path.resolve())
+
+
 def zip_is_intact(path) -> bool:
     """True for a non-empty zip whose every member passes its CRC check (a model file)."""
     import zipfile

@@ -185,3 +185,13 @@ def test_write_atomically_leaves_the_old_file_when_the_writer_fails(tmp_path):
         write_atomically(path, broken)
     assert path.read_text() == "old\n"
     assert os.listdir(tmp_path) in (["config.yml"], sorted(["config.yml", ".partial"]), [".partial", "config.yml"])
+
+
+def test_recorded_path_is_relative_under_the_working_folder_and_absolute_outside(tmp_path, monkeypatch):
+    from patrolsb3.runs import recorded_path
+    inside = tmp_path / "repo" / "runs" / "x" / "model.zip"
+    inside.parent.mkdir(parents=True)
+    monkeypatch.chdir(tmp_path / "repo")
+    assert recorded_path(inside) == "runs/x/model.zip"
+    assert recorded_path("runs/x") == "runs/x"
+    assert recorded_path(tmp_path / "elsewhere") == str((tmp_path / "elsewhere").resolve())

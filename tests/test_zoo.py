@@ -2,6 +2,7 @@
 import json
 import shutil
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -49,15 +50,17 @@ def test_export_keeps_the_policy_only_and_records_the_budget(trained):
     assert (folder / "curve.csv").is_file() and (folder / "command.txt").is_file()
 
 
-def test_export_of_a_stopped_run_takes_its_newest_checkpoint(trained, tmp_path):
+def test_export_of_a_stopped_run_takes_its_newest_checkpoint(trained, tmp_path, monkeypatch):
     import shutil
     run = tmp_path / "stopped"
     shutil.copytree(trained["run"], run)
     (run / "checkpoints").mkdir(exist_ok=True)
     shutil.move(run / "model.zip", run / "checkpoints" / "model_800_steps.zip")
+    monkeypatch.chdir(tmp_path)          # the repository root: sources are recorded relative to it
     folder = zoo.export(run, zoo_dir=tmp_path / "zoo")
     config = yaml.safe_load((folder / "config.yml").read_text())
-    assert config["source_model"].endswith("model_800_steps.zip")
+    assert config["source_model"] == "stopped/checkpoints/model_800_steps.zip"   # no path of this machine
+    assert config["source_run"] == "stopped"
     shutil.rmtree(run / "checkpoints")
     with pytest.raises(zoo.ZooError, match="no model.zip and no checkpoint"):
         zoo.export(run, zoo_dir=tmp_path / "zoo")
@@ -489,3 +492,14 @@ def test_an_entry_of_a_map_file_that_moved_still_loads_from_its_config(tmp_path)
     map_file.rename(tmp_path / "elsewhere.txt")
     policy = zoo.load_entry(folder)
     assert policy.spec.shape == (4, 6) and policy.spec.to_text() == config["map_text"]
+
+
+def test_no_zoo_record_names_a_folder_of_the_machine_it_was_made_on():
+    """config.yml and command.txt of every shipped entry, sweep and snapshot name paths relative
+    to the repository (a fresh clone elsewhere reads them the same)."""
+    import re
+    root = Path(__file__).resolve().parents[1] / "zoo"
+    machine_path = re.compile(r"(?<![\w.])/(?:work|home|tmp|Users|root|mnt|data)/")
+    offending = [str(p.relative_to(root)) for pattern in ("**/config.yml", "**/*.config.yml", "**/command.txt")
+                 for p in root.glob(pattern) if machine_path.search(p.read_text())]
+    assert offending == []

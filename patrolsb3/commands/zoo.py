@@ -15,7 +15,7 @@ from ..listening import listening
 from ..locks import hold
 from ..outputs import check_output_dir, check_output_file, write_json
 from ..report import clean_figures
-from ..runs import ZooEntry
+from ..runs import ZooEntry, recorded_path
 from ..zoo import (
     ZooError,
     existing_entry_dir,
@@ -120,15 +120,6 @@ def add_arguments(parser):
     p_abl.add_argument("--json", default=None, metavar="FILE", help="also write the figures as JSON")
 
 
-def relative_path(path) -> str:
-    """``path`` relative to the working folder when it lies under it, else in full."""
-    path = Path(path).resolve()
-    try:
-        return str(path.relative_to(Path.cwd().resolve()))
-    except ValueError:
-        return str(path)
-
-
 def headline(entry: dict) -> str:
     """Short text of an entry's evaluation: MAX and AVG idleness, collisions, BF rate per n."""
     ev = entry.get("eval") or {}
@@ -167,7 +158,7 @@ def run(args):
     if args.zoo_command == "eval":
         path = write_zoo_eval(chosen_entry(args), episodes=args.episodes,
                               steps=args.steps, seed=args.seed, deterministic=not args.stochastic)
-        print(f"evaluation written to {relative_path(path)}")
+        print(f"evaluation written to {recorded_path(path)}")
         return 0
     if args.zoo_command == "cards":
         check_output_dir(args.out, "--out")
@@ -194,7 +185,7 @@ def run(args):
         return 0
     if args.zoo_command == "show":
         entry = read_entry(chosen_entry(args))
-        entry["path"] = relative_path(entry["path"])      # no path of this machine in the output
+        entry["path"] = recorded_path(entry["path"])      # no path of this machine in the output
         print(json.dumps(entry, indent=2, default=str))
         return 0
     if args.zoo_command == "choose":

@@ -23,7 +23,7 @@ from stable_baselines3.common.vec_env import VecNormalize
 from .. import __version__
 from ..core.config import ENV_VERSION, EnvConfig, make_config
 from ..core.maps import is_shipped, load_map, source_label
-from ..runs import RunFolder, is_valid_model_file, model_steps, write_atomically
+from ..runs import RunFolder, is_valid_model_file, model_steps, recorded_path, write_atomically
 from .algorithms import DEFAULT_ALGORITHM, get_algorithm, torch_device
 from .callbacks import LearningCurveCallback, PaperMetricsEvalCallback
 from .cpu_time import CpuTimeCallback, cpu_hours_of, read_rows, restart_at
@@ -406,17 +406,6 @@ def warm_start_weights(init_from, algo_class, policy_class) -> tuple[dict, dict]
         errors.append(f"as a {policy_class.__name__}: {type(exc).__name__}: {exc}")
         raise ValueError(f"--init-from: {path} cannot be loaded ({'; '.join(errors)})") from exc
     return policy.state_dict(), {"path": recorded_path(path), **policy_budget(RunFolder(path.parent))}
-
-
-def recorded_path(path) -> str:
-    """How config.yml records a file: relative to the working directory when it lies under it
-    (a run started from the repository root names its source as ``runs/...``, no path of this
-    machine), else resolved and absolute."""
-    path = Path(path)
-    try:
-        return str(path.resolve().relative_to(Path.cwd().resolve()))
-    except ValueError:
-        return str(path.resolve())
 
 
 def policy_budget(folder: RunFolder) -> dict:

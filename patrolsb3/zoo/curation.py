@@ -10,7 +10,7 @@ from pathlib import Path
 import yaml
 
 from ..core.config import ENV_VERSION
-from ..runs import RunFolder, ZooEntry, write_atomically
+from ..runs import RunFolder, ZooEntry, recorded_path, write_atomically
 from .folders import ZooError, entry_dir
 
 
@@ -75,7 +75,7 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
             shutil.copyfile(run_dir / name, folder / name)
     config["env_version"] = config.get("versions", {}).get("env_version", ENV_VERSION)
     config["date"] = datetime.date.fromtimestamp(source.stat().st_mtime).isoformat()
-    config["source_model"] = str(source)
+    config["source_model"] = recorded_path(source)
     config["budget"] = {"timesteps": int(model.num_timesteps), **(budget or {})}
     if "cpu_hours" in config["budget"]:
         config["budget"]["cpu_hours_source"] = "given (--cpu-hours)"
@@ -87,7 +87,7 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
     if warm:  # a warm-started run: its budget includes the run it started from
         config["budget"]["timesteps_this_run"] = int(model.num_timesteps)
         config["budget"]["timesteps"] = int(model.num_timesteps) + int(warm)
-    config["source_run"] = str(run_dir)
+    config["source_run"] = recorded_path(run_dir)
     text = yaml.safe_dump(config, sort_keys=False)
     write_atomically(ZooEntry(folder).config_file, lambda partial: partial.write_text(text))
     return folder
