@@ -5,27 +5,43 @@
 # already evaluated under these draws is skipped, so the same command continues after a stop.
 # About 10 minutes per entry on one core. Run from the repository root:
 #
-#   zoo/reevaluate.sh            # every stale entry, the paper's setting and behind the guard
-#   zoo/reevaluate.sh A          # only map A's
+#   zoo/reevaluate.sh                  # every stale entry, the paper's setting and behind the guard
+#   zoo/reevaluate.sh A                # only map A's
+#   zoo/reevaluate.sh A,B,C,D guarded  # only the entries behind the guard (or: paper)
 #
-# Then the comparisons (their heuristics are evaluated again too, about 25 s a cell):
+# Each entry is checked again just before it is evaluated, so two calls on two cores (say one
+# for paper, one for guarded) never evaluate again an entry that the other has finished.
+#
+# Then the comparisons (their heuristics are evaluated again too, about 10 s a cell):
 #   patrolsb3 compare --maps A,B,C,D --agents 1-5 --episodes 10 --steps 14400 --out zoo/comparison \
 #     --faults-result zoo/comparison/faults_A_rl-msg_n3.json
 set -euo pipefail
 MAPS=${1:-}
-python - "$MAPS" <<'EOF' | while read -r map variant seed guarded; do
+KIND=${2:-}
+case "$KIND" in
+  ""|paper|guarded) ;;
+  *) echo "reevaluate.sh: the second argument must be paper or guarded, not '$KIND'" >&2; exit 2 ;;
+esac
+
+stale() {  # one line per stale entry: map variant seed|- paper|guarded
+  python - "$MAPS" "$KIND" <<'EOF'
 import sys
 from patrolsb3 import zoo
 from patrolsb3.core.streams import STREAMS_VERSION
 maps = set(sys.argv[1].upper().split(",")) if sys.argv[1] else None
 for entry in zoo.list_entries():
     config = entry["config"]
-    if maps and str(config["map"]).upper() not in maps:
+    kind = "guarded" if entry["guard"] else "paper"
+    if (maps and str(config["map"]).upper() not in maps) or sys.argv[2] not in ("", kind):
         continue
     if (entry["eval"] or {}).get("draws") != STREAMS_VERSION:
         seed = entry["seed"] if entry["seed"] is not None else "-"
-        print(config["map"], config["variant"], seed, "guarded" if entry["guard"] else "paper")
+        print(config["map"], config["variant"], seed, kind)
 EOF
+}
+
+stale | while read -r map variant seed guarded; do
+  stale | grep -qx "$map $variant $seed $guarded" || continue   # finished meanwhile by another call
   args=(zoo eval "$map" "$variant" --episodes 10 --steps 14400)
   [ "$seed" != "-" ] && args+=(--seed-of-entry "$seed")
   [ "$guarded" = guarded ] && args+=(--guarded)
