@@ -428,3 +428,16 @@ def claims_table(rows: list[dict]) -> str:
     lines = ["| the paper's claim | our figure (paired differences on the same episodes, 95 % intervals over training seeds where a zoo column pools several, Holm over each claim's comparisons) | verdict |", "|---|---|---|"]
     lines += [f"| {r['claim']} | {r['figure']} | **{r['verdict']}** |" for r in rows]
     return "\n".join(lines)
+
+
+def recipes_note(trained: dict) -> str:
+    """The lines under the claims table that say how each zoo column was trained.
+
+    Args:
+        trained: {(MAP, strategy label): phrase of :func:`patrolsb3.zoo.trained_with`}.
+    """
+    if not trained:
+        return ""
+    lines = ["Trained with (the recipe of each zoo column's seeds; docs/training.md compares the recipes):"]
+    lines += [f"- map {m}, {label}: {phrase}" for (m, label), phrase in sorted(trained.items())]
+    return "\n".join(lines)

@@ -196,8 +196,9 @@ def learning_curves(cells: list[Cell]) -> dict:
 
 def zoo_note(map_name: str, strategy: str, reused: bool, pooled=None) -> str:
     """The report's line about a zoo column: its setting (behind the return guard or the paper's),
-    which training seeds its figures are (pooled: ``(seeds pooled, seeds left out)``) and whether
-    they were reused from the entries' eval.json or computed now."""
+    which training seeds its figures are (pooled: ``(seeds pooled, seeds left out)``), whether
+    they were reused from the entries' eval.json or computed now, and the recipe the seeds were
+    trained with (:func:`patrolsb3.zoo.trained_with`)."""
     variant, guard = zoo.parse_strategy(strategy)
     folder = zoo.entry_dir(map_name, variant, guard=guard)
     config = zoo.read_entry(folder)["config"]
@@ -216,7 +217,8 @@ def zoo_note(map_name: str, strategy: str, reused: bool, pooled=None) -> str:
     if pooled and pooled[1]:
         which += (f"seed{'s' if len(pooled[1]) > 1 else ''} {', '.join(map(str, pooled[1]))} left out (no "
                   f"eval.json with per-episode figures for this protocol: 'patrolsb3 zoo eval'); ")
-    return f"{setting}; {which}figures {'reused from the eval.json' if reused else 'computed now'}"
+    return (f"{setting}; {which}figures {'reused from the eval.json' if reused else 'computed now'}; "
+            f"trained with {zoo.trained_with(map_name, variant, guard=guard)}")
 
 
 def default_reason(map_name: str, variant: str) -> str:

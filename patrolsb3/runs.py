@@ -55,9 +55,11 @@ class ConfigError(ValueError):
 
 CONFIG_SCHEMA = {"map": str, "map_source": str, "map_text": str, "map_shape": list, "variant": str, "algo": str, "seed": int,
                  "timesteps": int, "env": dict, "hyperparams": dict, "versions": dict, "init_from": dict,
-                 "env_version": str, "date": str, "source_model": str, "source_run": str, "budget": dict}
+                 "env_version": str, "date": str, "source_model": str, "source_run": str, "budget": dict,
+                 "recipe": str}
 """The keys a run's (or a zoo entry's) config.yml may hold, with their types: the train's own
-(map .. versions, init_from for a warm start) and those ``zoo export`` adds."""
+(map .. versions, init_from for a warm start, recipe: the ``--recipe`` it was given) and those
+``zoo export`` adds."""
 
 
 def read_config(path: Path) -> dict:

@@ -59,6 +59,7 @@ class Trial:
         overrides: hyperparameter overrides (recipe, then the sweep's ``set``, then the grid's).
         varied: the grid's ``set`` values of this trial, {dotted key: value} (in its name).
         run_dir: its run folder.
+        recipe: the sweep's ``recipe`` (recorded in the run's config.yml), None without one.
     """
     map: str
     variant: str
@@ -67,6 +68,7 @@ class Trial:
     overrides: dict
     varied: dict
     run_dir: Path
+    recipe: str | None = None
 
     @property
     def name(self) -> str:
@@ -186,7 +188,8 @@ def read_sweep(path, out=None, precision: str | None = None) -> list[Trial]:
         map_name, variant, seed = str(values["map"]), str(values["variant"]), int(values["seed"])
         trials.append(Trial(map=map_name, variant=variant, seed=seed, timesteps=int(timesteps),
                             overrides=merge(base, _nested(varied)), varied=varied,
-                            run_dir=Path(root) / _map_folder(map_name) / variant / run_id(seed, varied)))
+                            run_dir=Path(root) / _map_folder(map_name) / variant / run_id(seed, varied),
+                            recipe=spec.get("recipe")))
     names = [t.run_dir for t in trials]
     if len(set(names)) != len(names):
         raise SweepError(f"{path}: two trials share a run folder (repeated grid values?)")
@@ -240,7 +243,7 @@ def run_trial(trial: Trial, torch_threads: int = 1) -> dict:
         hyperparams = merge({"torch_threads": int(torch_threads)}, trial.overrides)
         train(map=trial.map, variant=trial.variant, timesteps=trial.timesteps, seed=trial.seed,
               run_dir=trial.run_dir, resume=state == "resumable", hyperparams=hyperparams,
-              progress_bar=False, device="cpu",
+              progress_bar=False, device="cpu", recipe=trial.recipe,
               command=f"patrolsb3 sweep (trial {trial.name}, {trial.timesteps} agent-steps)")
     return {"timesteps": model_steps(RunFolder(trial.run_dir).model_file) or 0,
             "seconds": round(time.time() - started, 1)}

@@ -161,6 +161,9 @@ def test_the_command_on_a_comparison_and_its_refusals(tmp_path, capsys):
     assert cli.main(["claims", str(tmp_path / "c"), "--json", str(tmp_path / "claims.json")]) == 0
     out = capsys.readouterr().out
     assert out.count("\n| ") == 10 and "CR collides most" in out          # ten claims
+    # and how the zoo column was trained (the zoo's A/rl-msg: c_d 200, not the paper's 10)
+    assert "Trained with" in out and "- map A, RL-MSG: " in out and "(c_d 200, gamma 0.99" in out
+    assert "trained with " in (tmp_path / "c" / "report.md").read_text()
     assert cli.main(["claims", str(tmp_path / "nothing")]) == 2
     assert "no results.csv" in capsys.readouterr().err
     before = (tmp_path / "c" / "results.csv").read_text()                 # its own input is refused

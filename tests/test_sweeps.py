@@ -39,6 +39,7 @@ def test_the_grid_is_the_product_of_its_lists_each_trial_a_run_folder(tmp_path):
     assert first.overrides["n_steps"] == 10 and first.overrides["learning_rate"] == 3e-4
     assert first.overrides["env"]["c_home"] == 0.0 and first.overrides["env"]["episode_steps"] == 300
     assert first.varied == {"learning_rate": 3e-4, "env.c_home": 0.0}
+    assert first.recipe == "zoo-stage1"          # given to train, which records it in config.yml
     assert read_sweep(write(tmp_path, SWEEP.format(out="x")), out=tmp_path / "o")[0].run_dir.parts[-4] == "o"
 
 
@@ -125,3 +126,15 @@ def test_a_folder_with_files_and_no_checkpoint_is_blocked_not_new(tmp_path):
     assert trial_state(trial) == "new"                               # empty: the sweep may start it
     (trial.run_dir / "curve.csv").write_text("timesteps\n")
     assert trial_state(trial) == "blocked"
+
+
+def test_a_trial_records_its_sweeps_recipe_in_the_run_config(tmp_path):
+    import yaml
+
+    from patrolsb3.sweeps import Trial, run_trial
+    tiny = {"n_steps": 16, "n_minibatches": 2, "n_envs": 2, "eval_freq": 0, "checkpoint_freq": 10**9,
+            "env": {"episode_steps": 20}, "policy_kwargs": {"dense_sizes": [32, 16], "lstm_hidden_size": 8}}
+    trial = Trial(map="A", variant="rl-no-msg", seed=0, timesteps=320, overrides=tiny, varied={},
+                  run_dir=tmp_path / "A" / "rl-no-msg" / "seed0", recipe="paper")
+    assert run_trial(trial)["timesteps"] >= 320
+    assert yaml.safe_load((trial.run_dir / "config.yml").read_text())["recipe"] == "paper"

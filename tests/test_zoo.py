@@ -32,7 +32,7 @@ def trained(tmp_path_factory):
     hp = {"n_steps": 16, "n_minibatches": 2, "n_envs": 2, "eval_freq": 0, "checkpoint_freq": 10**9,
           "env": {"episode_steps": 20}, "policy_kwargs": {"dense_sizes": [32, 16], "lstm_hidden_size": 8}}
     run = train(map=str(map_file), variant="rl-msg", timesteps=800, run_dir=root / "run", hyperparams=hp,
-                progress_bar=False)
+                progress_bar=False, recipe="default")
     folder = zoo.export(run, zoo_dir=root / "zoo", budget={"cpu_hours": 0.001})
     return {"root": root, "map_file": map_file, "run": run, "folder": folder}
 
@@ -48,6 +48,17 @@ def test_export_keeps_the_policy_only_and_records_the_budget(trained):
     assert config["env_version"] == "patrol_v1"
     assert config["budget"]["timesteps"] >= 800 and config["budget"]["cpu_hours"] == 0.001
     assert (folder / "curve.csv").is_file() and (folder / "command.txt").is_file()
+
+
+def test_a_zoo_column_says_which_recipe_its_seeds_were_trained_with(trained):
+    config = yaml.safe_load((trained["folder"] / "config.yml").read_text())
+    assert config["recipe"] == "default"             # train records it, export keeps it
+    c_d = 50 / config["env"]["max_agents"]           # the paper's default when c_d is not set
+    assert zoo.trained_with("ROOM", "rl-msg", trained["root"] / "zoo") == \
+        f"default (c_d {c_d:g}, gamma {config['hyperparams']['gamma']}, 20-step episodes): seed 0"
+    config.pop("recipe")
+    config["env"]["c_d"] = 200.0
+    assert zoo.recipe_of(config).startswith("recipe not recorded (c_d 200, ")
 
 
 def test_export_of_a_stopped_run_takes_its_newest_checkpoint(trained, tmp_path, monkeypatch):

@@ -1,8 +1,8 @@
 """``patrolsb3 claims COMPARE_DIR``: the paper's claims, one row each, with our figure, its 95 %
 interval and a verdict, from a comparison's results (``patrolsb3.claims``)."""
 from .. import zoo
-from ..claims import claims, claims_table, read_faults_result, read_figures
-from ..names import is_learned
+from ..claims import claims, claims_table, read_faults_result, read_figures, recipes_note
+from ..names import display_name, is_learned
 from ..outputs import check_output_file, write_json
 
 
@@ -33,6 +33,12 @@ def run(args):
               for m in sorted({k[0] for k in figures})}
     rows = claims(figures, curves=curves, faults_result=faults)
     print(claims_table(rows))
+    trained = {(m, display_name(name)): zoo.trained_with(m, zoo.parse_strategy(name)[0], args.zoo_dir,
+                                                            guard=args.guarded)
+               for m, name in sorted({(k[0], k[2]) for k in figures if is_learned(k[2])})
+               if zoo.available(m, zoo.parse_strategy(name)[0], args.zoo_dir, guard=args.guarded)}
+    if trained:
+        print("\n" + recipes_note(trained))
     if args.json:
         write_json(args.json, rows, indent=2)
     return 0

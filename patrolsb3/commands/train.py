@@ -49,6 +49,6 @@ def run(args):
                     hyperparams_file=args.hyperparams, eval_freq=args.eval_freq,
                     checkpoint_freq=args.checkpoint_freq, progress_bar=not args.no_progress,
                     verbose=args.verbose, run_id=args.run_id, command="patrolsb3 " + " ".join(sys.argv[1:]),
-                    device=args.device)
+                    device=args.device, recipe=args.recipe)
     print(f"run folder: {run_dir}")
     return 0

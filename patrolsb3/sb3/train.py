@@ -433,7 +433,7 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
           seed: int = 0, resume: bool = False, init_from=None, hyperparams: dict | None = None, hyperparams_file=None,
           n_envs: int | None = None, eval_freq: int | None = None, checkpoint_freq: int | None = None,
           progress_bar: bool = True, verbose: int = 0, run_id: str | None = None, run_dir=None,
-          command: str | None = None, device: str = "auto") -> Path:
+          command: str | None = None, device: str = "auto", recipe: str | None = None) -> Path:
     """Train a parameter-shared policy and write its run folder (see module docstring).
 
     Args:
@@ -459,6 +459,9 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
         command: the command line recorded in command.txt (default: sys.argv).
         device: where the networks train: "auto" (cuda when torch sees one, else cpu), "cpu"
             or "cuda". The simulator always runs on the CPU.
+        recipe: the name of the recipe whose overrides ``hyperparams`` holds
+            (:mod:`patrolsb3.sb3.recipes`), recorded in config.yml as ``recipe`` so that a zoo
+            column can say how it was trained; None records nothing.
 
     Returns:
         The run folder.
@@ -484,7 +487,8 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
     config = {"map": spec_map.name, "map_source": source_label(spec_map),
               **({} if is_shipped(spec_map) else {"map_text": spec_map.to_text()}), "map_shape": list(spec_map.shape),
               "variant": variant, "algo": spec.name, "seed": int(seed), "timesteps": total,
-              "env": cfg.to_dict(), "hyperparams": hp, "versions": versions()}
+              "env": cfg.to_dict(), "hyperparams": hp, "versions": versions(),
+              **({"recipe": recipe} if recipe else {})}
     if resume and init_from is not None:
         raise ValueError("--init-from starts a new run; --resume continues one: give only one of them")
     warm_weights = None

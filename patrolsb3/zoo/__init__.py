@@ -9,7 +9,8 @@ One job a module:
 - :mod:`~patrolsb3.zoo.curation`: putting a training run into the zoo (``zoo export``);
 - :mod:`~patrolsb3.zoo.validation`: choosing a checkpoint or an entry's default seed by
   validation (``zoo validate``, ``zoo choose``; it runs episodes, so import it by name);
-- :mod:`~patrolsb3.zoo.results`: an entry's stored figures, one seed's or pooled over seeds;
+- :mod:`~patrolsb3.zoo.results`: an entry's stored figures, one seed's or pooled over seeds, and
+  the recipe its seeds were trained with;
 - :mod:`~patrolsb3.zoo.cards`: the model cards (``zoo cards``; import it by name).
 
 The strategy names (``zoo:<variant>``, ``zoo:<variant>:guarded``) and the variants live in
@@ -37,10 +38,11 @@ from .folders import (
     zoo_root,
 )
 from .policy import ZooPolicy, checked_map, env_config, evaluation_config, load, load_checkpoint, load_entry
-from .results import cached_result, pooled_result
+from .results import cached_result, pooled_result, recipe_of, trained_with
 
 __all__ = ["DEFAULT_FILE", "GUARDED", "VARIANT_NAMES", "ZOO_DIR", "ZOO_ENV", "ZooError", "ZooPolicy",
            "available", "cached_result", "checked_map", "default_seed", "entry_dir", "env_config",
            "evaluation_config", "existing_entry_dir", "export", "export_destination", "list_entries", "load",
-           "load_checkpoint", "load_entry", "parse_strategy", "pooled_result", "read_entry", "replace_entry",
-           "seed_curves", "seeds", "strategy_name", "training_map", "use_zoo_dir", "variant_folder", "zoo_root"]
+           "load_checkpoint", "load_entry", "parse_strategy", "pooled_result", "read_entry", "recipe_of",
+           "replace_entry", "seed_curves", "seeds", "strategy_name", "trained_with", "training_map", "use_zoo_dir",
+           "variant_folder", "zoo_root"]

@@ -1,5 +1,6 @@
-"""An entry's stored evaluation figures: one seed's eval.json result for a protocol, and the
-figures of every training seed pooled with the training seed as the unit."""
+"""An entry's stored evaluation figures: one seed's eval.json result for a protocol, the
+figures of every training seed pooled with the training seed as the unit, and how the seeds
+of a zoo column were trained (their recipe)."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,7 +10,7 @@ from ..names import strategy_name
 from ..outputs import read_eval_file
 from ..runs import ZooEntry
 from ..stats import RATE_METRICS, rate_interval, seed_interval
-from .folders import entry_dir, seeds
+from .folders import entry_dir, read_entry, seeds
 
 
 def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, steps: int, seed: int,
@@ -83,3 +84,33 @@ def pooled_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
         else:
             summary[metric] = value
     return {**first, "summary": summary, "training_seeds": [k for k, _ in usable], "unpooled_seeds": left_out}
+
+
+def recipe_of(config: dict) -> str:
+    """How one entry was trained, in a phrase: its recipe (config.yml's ``recipe``; "recipe not
+    recorded" for entries made before runs recorded it) and the three settings on which the
+    zoo's recipe and the paper's differ most (docs/training.md): the difference-reward weight
+    c_d, gamma and the training episodes' length.
+
+    Example: ``zoo-stage2 (c_d 200, gamma 0.99, 1,500-step episodes)``.
+    """
+    env, hp = config.get("env") or {}, config.get("hyperparams") or {}
+    c_d = env.get("c_d")
+    c_d = 50.0 / env.get("max_agents", 5) if c_d is None else c_d      # EnvConfig.difference_weight
+    steps = env.get("episode_steps")
+    length = f"{steps:,}-step episodes" if isinstance(steps, int) else "episodes of unrecorded length"
+    return f"{config.get('recipe') or 'recipe not recorded'} (c_d {c_d:g}, gamma {hp.get('gamma', '?')}, {length})"
+
+
+def trained_with(map_name: str, variant: str, zoo_dir=None, guard: bool = False) -> str:
+    """How the entries of a zoo column were trained: each distinct :func:`recipe_of` with the
+    training seeds that have it, e.g. ``zoo-stage2 (c_d 200, gamma 0.99, 1,500-step episodes):
+    seeds 0, 1, 2``. The entry behind the guard has one folder and no seeds."""
+    if guard:
+        return recipe_of(read_entry(entry_dir(map_name, variant, zoo_dir, guard=True))["config"])
+    by_recipe: dict[str, list[int]] = {}
+    for seed in seeds(map_name, variant, zoo_dir):
+        config = read_entry(entry_dir(map_name, variant, zoo_dir, seed=seed))["config"]
+        by_recipe.setdefault(recipe_of(config), []).append(seed)
+    return "; ".join(f"{phrase}: seed{'s' if len(found) > 1 else ''} {', '.join(map(str, found))}"
+                     for phrase, found in by_recipe.items())
