@@ -5,6 +5,9 @@ candidate models of each recipe, on the validation seed only.
         E0=zoo/A/rl-msg/seed0,zoo/A/rl-msg/seed1,zoo/A/rl-msg/seed2 \
         E1=PATH,PATH,PATH E2=PATH,PATH,PATH [--steps 14400] [--episodes 10] [--json FILE]
 
+With ``--json FILE``, a model whose figures FILE already holds for the same episodes and steps is
+not played again (E0's figures, computed once, serve when E1 and E2 come in).
+
 Each PATH is a zoo entry folder or a checkpoint (``<run>/checkpoints/model_<k>_steps.zip``, the one
 ``zoo validate RUN --last 6`` picked). Every candidate plays ``--episodes`` greedy episodes per team
 size 1-5 on simulator seed 7 (never the evaluation's 0), all team sizes in one batch with episode j
@@ -69,19 +72,30 @@ def main() -> None:
     parser.add_argument("--json", default=None)
     args = parser.parse_args()
     recipes, rows, seeds = {}, [], {}
+    known = {}
+    if args.json and Path(args.json).is_file():
+        known = {(r["model"], r.get("episodes"), r.get("steps")): r for r in json.loads(Path(args.json).read_text())["seeds"]}
+    figure_names = ("bf_rate_3_5", "collisions_3_5", "avg_idleness_1_5")
     for item in args.recipes:
         name, _, paths = item.partition("=")
         per_seed = []
         for path in paths.split(","):
-            figures = candidate_figures(Path(path), args.episodes, args.steps)
+            found = known.get((path, args.episodes, args.steps))
+            figures = ({k: found[k] for k in figure_names} if found
+                       else candidate_figures(Path(path), args.episodes, args.steps))
             per_seed.append(figures)
-            rows.append({"recipe": name, "model": path, **figures})
+            rows.append({"recipe": name, "model": path, "episodes": args.episodes, "steps": args.steps, **figures})
             print(f"{name} {path}: " + ", ".join(f"{k} {v:.3f}" for k, v in figures.items()), flush=True)
         recipes[name] = {k: float(np.mean([f[k] for f in per_seed])) for k in per_seed[0]}
         seeds[name] = len(per_seed)
-    chosen, why = choose(recipes)
+    if args.json:     # every model's figures kept at once, before the choice
+        Path(args.json).write_text(json.dumps({"seeds": rows}, indent=2))
     for name, f in recipes.items():
         print(f"{name} (mean of {seeds[name]} seeds): " + ", ".join(f"{k} {v:.3f}" for k, v in f.items()))
+    if len(recipes) < 2:      # figures of one recipe, kept for later: nothing to choose between yet
+        print("one recipe given: its figures are kept; the rule chooses once E0, E1 and E2 are all in")
+        return
+    chosen, why = choose(recipes)
     print(f"chosen: {chosen} ({why})")
     if args.json:
         Path(args.json).write_text(json.dumps({"seeds": rows, "recipes": recipes, "chosen": chosen, "why": why},
