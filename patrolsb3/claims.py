@@ -45,6 +45,9 @@ HEURISTICS = ("CR", "PART", "SEBS")
 PAPER_STRATEGIES = HEURISTICS + LEARNED
 LABEL = {name: display_name(name) for name in PAPER_STRATEGIES}
 """How each strategy is named in a claim (:func:`patrolsb3.names.display_name`)."""
+NO_WORSE_MARGIN = 0.05
+"""A claim that a strategy is "no worse" holds where it is shown to be at most this fraction of
+each rival's figure worse (a non-inferiority margin; the paper gives none)."""
 NEAR_ZERO = 0.05
 """A battery failure rate 'near zero' (the paper's word) is at most this."""
 HOLDS, FAILS, OPEN = "holds", "does not hold", "inconclusive"
@@ -157,14 +160,21 @@ def _cells(figures: dict, who: str, metric: str, maps=None, sizes=None) -> list[
                    and not math.isnan(figures[(m, n, s, k)].mean)})
 
 
-def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, highest: bool = False) -> dict:
-    """Whether ``who`` has the lowest (or ``highest``) ``metric`` against ``rivals`` in every
-    cell: {"verdict", "figure", "cells"} (the verdict rule: module docstring). The figure says who
-    wins where: the cells where ``who`` is best, each rival that beats it and in which cells, the
-    level cells, and one example with the paired difference."""
+def _comparisons(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None):
+    """Every paired comparison of ``who`` with its rivals, cell by cell.
+
+    A cell where ``who`` is below the floor is not tested. A cell where only some rivals are
+    below it is tested against the others (a rival there can still be shown better), but it
+    counts as too few to test: it cannot be won against every rival.
+
+    Returns:
+        compared (cells with a rival), too_few (cells with ``who`` or a rival below the floor),
+        unmeasured (cells with a comparison that has no per-episode figures), tested [((m, n),
+        rival, Difference of who - rival)] and cells [((m, n), rivals in it)] of the cells
+        tested against every rival.
+    """
     compared = too_few = unmeasured = 0
-    tested = []                      # ((m, n), rival, Difference of who - rival)
-    cells = []
+    tested, cells = [], []
     for m, n in _cells(figures, who, metric, maps, sizes):
         mine = figures[(m, n, who, metric)]
         others = {r: figures[(m, n, r, metric)] for r in rivals if (m, n, r, metric) in figures
@@ -172,14 +182,24 @@ def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, 
         if not others:
             continue
         compared += 1
-        if not all(f.testable for f in (mine, *others.values())):
+        testable = {r: o for r, o in others.items() if o.testable} if mine.testable else {}
+        if len(testable) < len(others):
             too_few += 1
-            continue
-        diffs = {r: difference(mine, o) for r, o in others.items()}
+        diffs = {r: difference(mine, o) for r, o in testable.items()}
         if any(d is None for d in diffs.values()):
             unmeasured += 1
-        cells.append(((m, n), list(others)))
+        if testable and len(testable) == len(others):
+            cells.append(((m, n), list(others)))
         tested += [((m, n), r, d) for r, d in diffs.items() if d is not None]
+    return compared, too_few, unmeasured, tested, cells
+
+
+def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, highest: bool = False) -> dict:
+    """Whether ``who`` has the lowest (or ``highest``) ``metric`` against ``rivals`` in every
+    cell: {"verdict", "figure", "cells"} (the verdict rule: module docstring). The figure says who
+    wins where: the cells where ``who`` is best, each rival that beats it and in which cells, the
+    level cells, and one example with the paired difference."""
+    compared, too_few, unmeasured, tested, cells = _comparisons(figures, who, rivals, metric, maps, sizes)
     if compared == 0:
         return {"verdict": OPEN, "figure": "not measured (no such cells in this comparison)", "cells": 0}
     significant = holm([d.p for _, _, d in tested])
@@ -191,19 +211,27 @@ def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, 
     beaten_by = {}
     for (cell, r) in sorted(lost):
         beaten_by.setdefault(r, []).append(_where(cell))
-    level = len(cells) - wins - len(losing_cells)
+    level = sum(cell not in losing_cells and not all((cell, r) in won for r in rivals_here)
+                for cell, rivals_here in cells)         # tested against every rival, neither won nor lost
     word = "highest" if highest else "lowest"
     figure = f"significantly {word} in {wins} of {compared} cells; significantly beaten in {len(losing_cells)}"
     if beaten_by:            # who wins where
         figure += " (" + "; ".join(f"by {LABEL.get(r, r)} in {len(c)}: {', '.join(c)}" for r, c in beaten_by.items()) + ")"
     figure += f"; level in {level}"
     example = None
-    if lost or won:          # one cell: both figures with their intervals, and the paired difference
-        shown = min(lost) if lost else min(won)
+    if tested:               # one cell: both figures with their intervals, and the paired difference
+        if lost or won:      # a significant one; else the comparison nearest to significance
+            shown = min(lost) if lost else min(won)
+            note = ""
+        else:
+            cell, r, _ = min(tested, key=lambda c: c[2].p)
+            shown, note = (cell, r), ", not significant after Holm"
         (cell, r), d = shown, next(d for c, rr, d in tested if (c, rr) == shown)
         mine, theirs = (figures[(*cell, s, metric)] for s in (who, r))
         example = (f"map {_where(cell)}: {LABEL.get(who, who)} {mine.text()} vs {LABEL.get(r, r)} {theirs.text()}, "
-                   f"paired difference {d.text()} over {d.unit}")
+                   f"paired difference {d.text()} over {d.unit}, p = {d.p:.2g}{note}")
+    if tested:
+        figure += f"; Holm over {len(tested)} comparisons"
     figure += _untested_and_example(unmeasured, too_few, example)
     verdict = FAILS if lost else HOLDS if wins == compared else OPEN
     return {"verdict": verdict, "figure": figure, "cells": compared, "unmeasured": unmeasured}
@@ -222,11 +250,28 @@ def _untested_and_example(unmeasured: int, too_few: int, example: str | None) ->
     return tail + (f" (e.g. {example})" if example else "")
 
 
-def no_worse(figures: dict, who: str, rivals, metric: str, maps=None) -> dict:
-    """Whether no rival is significantly lower than ``who`` in any cell."""
+def no_worse(figures: dict, who: str, rivals, metric: str, maps=None, margin: float = NO_WORSE_MARGIN) -> dict:
+    """Whether ``who`` is no worse (no higher ``metric``) than any rival in any cell, within
+    ``margin`` times the rival's mean (a non-inferiority margin).
+
+    Each comparison is tested one-sided each way against that bound
+    (:meth:`patrolsb3.stats.Difference.p_below`, ``p_above``), Holm over the claim's comparisons
+    for each side. Does not hold where some rival is shown better by more than the margin. Holds
+    where every cell is testable and every comparison shows ``who`` within the margin. Otherwise
+    inconclusive: not significantly worse is not shown to be no worse. The figure also says who
+    wins where with no margin (:func:`lowest`).
+    """
     result = lowest(figures, who, rivals, metric, maps)
-    if result["cells"] and result["verdict"] == OPEN and not result["unmeasured"]:
-        result["verdict"] = HOLDS                     # no rival significantly better anywhere
+    if not result["cells"]:
+        return result
+    _, too_few, unmeasured, tested, _ = _comparisons(figures, who, rivals, metric, maps)
+    bounds = [margin * abs(figures[(*cell, r, metric)].mean) for cell, r, _ in tested]
+    within = holm([d.p_below(bound) for (_, _, d), bound in zip(tested, bounds)])
+    beyond = holm([d.p_above(bound) for (_, _, d), bound in zip(tested, bounds)])
+    result["figure"] += (f"; with a {margin:.0%} margin: shown worse by more in {sum(beyond)}, shown within it in "
+                         f"{sum(within)} of {len(tested)} comparisons")
+    complete = bool(tested) and not too_few and not unmeasured
+    result["verdict"] = FAILS if any(beyond) else HOLDS if complete and all(within) else OPEN
     return result
 
 

@@ -93,15 +93,35 @@ def testable(episodes: int, training_seeds: int | None) -> bool:
 @dataclass(frozen=True)
 class Difference:
     """A paired comparison of two strategies in one cell: the mean of ``a - b``, its 95 % interval
-    and the two-sided p-value of "no difference" (:func:`paired_difference`)."""
+    and the two-sided p-value of "no difference" (:func:`paired_difference`), with the t test's
+    standard error and degrees of freedom (nan for a difference that is the same everywhere)."""
     mean: float
     low: float
     high: float
     p: float
     unit: str            # what the interval is over: "episodes", "training seeds" or "training seeds (Welch)"
+    se: float = float("nan")
+    df: float = float("nan")
 
     def text(self, digits: int = 1) -> str:
         return f"{self.mean:+.{digits}f} [{self.low:+.{digits}f}, {self.high:+.{digits}f}]"
+
+    def p_below(self, bound: float) -> float:
+        """One-sided p-value of "the difference is at least ``bound``" (small when the data show
+        that a - b is below ``bound``): Student's t with this difference's standard error and
+        degrees of freedom; a difference that is the same everywhere gives 0 or 1."""
+        from scipy.stats import t as student_t
+        if not np.isfinite(self.se) or self.se <= 0:
+            return 0.0 if self.mean < bound else 1.0
+        return float(student_t.cdf((self.mean - bound) / self.se, self.df))
+
+    def p_above(self, bound: float) -> float:
+        """One-sided p-value of "the difference is at most ``bound``" (small when the data show
+        that a - b is above ``bound``); the mirror of :meth:`p_below`."""
+        from scipy.stats import t as student_t
+        if not np.isfinite(self.se) or self.se <= 0:
+            return 0.0 if self.mean > bound else 1.0
+        return float(student_t.sf((self.mean - bound) / self.se, self.df))
 
 
 def paired_difference(a_units, b_units) -> Difference | None:
@@ -134,8 +154,10 @@ def paired_difference(a_units, b_units) -> Difference | None:
             return Difference(diff, diff, diff, 1.0 if diff == 0 else 0.0, "training seeds (Welch)")
         test = ttest_ind(means_a, means_b, equal_var=False)
         ci = test.confidence_interval(0.95)
-        return Difference(float(means_a.mean() - means_b.mean()), float(ci.low), float(ci.high),
-                          float(test.pvalue), "training seeds (Welch)")
+        diff = float(means_a.mean() - means_b.mean())
+        se = float(np.sqrt(means_a.var(ddof=1) / len(means_a) + means_b.var(ddof=1) / len(means_b)))
+        return Difference(diff, float(ci.low), float(ci.high), float(test.pvalue), "training seeds (Welch)",
+                          se=se, df=float(test.df))
     flip = len(b) > 1                                  # several units on b's side: a - b = -(b - a)
     many, one = (b, a[0]) if flip else (a, b[0])
     if len(many) > 1:
@@ -155,7 +177,8 @@ def paired_difference(a_units, b_units) -> Difference | None:
         return Difference(mean, mean, mean, 1.0 if abs(mean) <= 1e-9 else 0.0, unit)
     test = ttest_1samp(values, 0.0)
     ci = test.confidence_interval(0.95)
-    return Difference(mean, float(ci.low), float(ci.high), float(test.pvalue), unit)
+    return Difference(mean, float(ci.low), float(ci.high), float(test.pvalue), unit,
+                      se=float(values.std(ddof=1) / np.sqrt(len(values))), df=float(len(values) - 1))
 
 
 FAMILY_ALPHA = 0.05

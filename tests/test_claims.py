@@ -40,7 +40,7 @@ def test_lowest_holds_fails_or_stays_open():
     assert lowest(figures, "me", ["you"], "x")["verdict"] == OPEN                  # n=2 level
     assert lowest(figures, "you", ["me"], "x")["verdict"] == FAILS
     assert lowest(figures, "you", ["me"], "x", highest=True)["verdict"] == OPEN
-    assert no_worse(figures, "me", ["you"], "x")["verdict"] == HOLDS
+    assert no_worse(figures, "me", ["you"], "x")["verdict"] == OPEN               # n=2: level, not shown no worse
     assert no_worse(figures, "you", ["me"], "x")["verdict"] == FAILS
     assert lowest(figures, "me", ["nobody"], "x")["verdict"] == OPEN
 
@@ -72,6 +72,25 @@ def test_holm_adjusts_a_claims_comparisons_for_their_number():
     result = lowest(figures, "me", ["you"], "x")
     assert result["verdict"] == OPEN and "level in 3" in result["figure"]
     assert lowest(figures, "me", ["you"], "x", sizes=[1])["verdict"] == HOLDS      # alone, one is enough
+
+
+def test_no_worse_holds_only_where_the_data_show_it_within_the_margin():
+    shared = np.random.default_rng(5).normal(50, 10, 12)            # the same hard and easy episodes
+    you = Figure(50, 45, 55, units=(tuple(shared),))
+    close = Figure(50.5, 45, 56, units=(tuple(shared + 0.5 + 0.1 * np.sin(np.arange(12))),))
+    assert no_worse({("A", 1, "me", "x"): close, ("A", 1, "you", "x"): you}, "me", ["you"], "x")["verdict"] == HOLDS
+    # +0.5 of 50 is inside the 5 % margin (2.5) and tight; +2.3 with wide noise is not shown inside it
+    noisy = Figure(52.3, 40, 64, units=(tuple(shared + 2.3 + 3 * np.random.default_rng(6).normal(size=12)),))
+    result = no_worse({("A", 1, "me", "x"): noisy, ("A", 1, "you", "x"): you}, "me", ["you"], "x")
+    assert result["verdict"] == OPEN and "shown within it in 0 of 1" in result["figure"]
+    # worse by far more than the margin, clearly: does not hold
+    far = Figure(60, 55, 65, units=(tuple(shared + 10 + 0.1 * np.cos(np.arange(12))),))
+    assert no_worse({("A", 1, "me", "x"): far, ("A", 1, "you", "x"): you}, "me", ["you"], "x")["verdict"] == FAILS
+    # a cell below the floor keeps the claim open even where every tested cell is shown
+    figures = {("A", 1, "me", "x"): close, ("A", 1, "you", "x"): you,
+               ("A", 2, "me", "x"): Figure(1, 0, 2, testable=False, units=((1.0,) * 12,)),
+               ("A", 2, "you", "x"): Figure(1, 0, 2, units=((1.0,) * 12,))}
+    assert no_worse(figures, "me", ["you"], "x")["verdict"] == OPEN
 
 
 def test_no_worse_without_per_episode_figures_is_inconclusive():
@@ -230,3 +249,14 @@ def test_the_figure_says_who_wins_where():
                ("A", 2, "CR", "max_idleness"): fig(3.1, seed=4)}
     figure = lowest(figures, "zoo:rl-msg", ["CR"], "max_idleness")["figure"]
     assert "significantly beaten in 1 (by CR in 1: A n=1); level in 1" in figure
+
+
+def test_a_rival_below_the_floor_leaves_the_others_tested():
+    """A one-seed zoo column in a cell does not hide that a heuristic there is clearly better."""
+    figures = {("A", 1, "me", "x"): fig(10, seed=1), ("A", 1, "you", "x"): fig(1, seed=2),
+               ("A", 1, "one-seed", "x"): fig(5, seed=3, testable=False)}
+    result = lowest(figures, "me", ["you", "one-seed"], "x")
+    assert result["verdict"] == FAILS and "by you in 1" in result["figure"]
+    assert "1 cells too few to test" in result["figure"] and "level in 0" in result["figure"]
+    # and it cannot be won against every rival: the winner's claim stays open
+    assert lowest(figures, "you", ["me", "one-seed"], "x")["verdict"] == OPEN

@@ -61,3 +61,15 @@ def test_too_few_to_test_below_the_floor():
                ("A", 1, "CR", "max_idleness"): high}                # clearly apart, but too few
     result = lowest(figures, "zoo:rl-msg", ["CR"], "max_idleness")
     assert result["verdict"] == "inconclusive" and "1 cells too few to test" in result["figure"]
+
+
+def test_one_sided_p_values_against_a_bound_mirror_each_other():
+    from scipy.stats import t as student_t
+
+    from patrolsb3.stats import Difference
+    d = Difference(0.0, -1.0, 1.0, 1.0, "episodes", se=1.0, df=10.0)
+    assert d.p_below(2.0) == pytest.approx(student_t.cdf(-2.0, 10))       # about 0.037: shown below 2
+    assert d.p_above(-2.0) == pytest.approx(d.p_below(2.0))
+    assert d.p_below(-2.0) > 0.95 and d.p_above(2.0) > 0.95
+    same_everywhere = Difference(1.0, 1.0, 1.0, 0.0, "episodes")          # no spread: decided outright
+    assert same_everywhere.p_below(1.5) == 0.0 and same_everywhere.p_above(1.5) == 1.0

@@ -41,7 +41,8 @@ EOF
 }
 
 stale | while read -r map variant seed guarded; do
-  stale | grep -qx "$map $variant $seed $guarded" || continue   # finished meanwhile by another call
+  still=$(stale)          # read whole: grep -q on a pipe would cut the list short (a broken pipe)
+  grep -qx "$map $variant $seed $guarded" <<< "$still" || continue   # finished meanwhile by another call
   args=(zoo eval "$map" "$variant" --episodes 10 --steps 14400)
   [ "$seed" != "-" ] && args+=(--seed-of-entry "$seed")
   [ "$guarded" = guarded ] && args+=(--guarded)
