@@ -194,12 +194,14 @@ def _comparisons(figures: dict, who: str, rivals, metric: str, maps=None, sizes=
     return compared, too_few, unmeasured, tested, cells
 
 
-def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, highest: bool = False) -> dict:
+def lowest(figures: dict, who: str, rivals, metric: str, maps=None, sizes=None, highest: bool = False,
+           comparisons=None) -> dict:
     """Whether ``who`` has the lowest (or ``highest``) ``metric`` against ``rivals`` in every
     cell: {"verdict", "figure", "cells"} (the verdict rule: module docstring). The figure says who
     wins where: the cells where ``who`` is best, each rival that beats it and in which cells, the
-    level cells, and one example with the paired difference."""
-    compared, too_few, unmeasured, tested, cells = _comparisons(figures, who, rivals, metric, maps, sizes)
+    level cells, and one example with the paired difference. ``comparisons``: what
+    :func:`_comparisons` returned for these arguments, when the caller has it already."""
+    compared, too_few, unmeasured, tested, cells = comparisons or _comparisons(figures, who, rivals, metric, maps, sizes)
     if compared == 0:
         return {"verdict": OPEN, "figure": "not measured (no such cells in this comparison)", "cells": 0}
     significant = holm([d.p for _, _, d in tested])
@@ -261,10 +263,11 @@ def no_worse(figures: dict, who: str, rivals, metric: str, maps=None, margin: fl
     inconclusive: not significantly worse is not shown to be no worse. The figure also says who
     wins where with no margin (:func:`lowest`).
     """
-    result = lowest(figures, who, rivals, metric, maps)
+    comparisons = _comparisons(figures, who, rivals, metric, maps)
+    result = lowest(figures, who, rivals, metric, maps, comparisons=comparisons)
     if not result["cells"]:
         return result
-    _, too_few, unmeasured, tested, _ = _comparisons(figures, who, rivals, metric, maps)
+    _, too_few, unmeasured, tested, _ = comparisons
     bounds = [margin * abs(figures[(*cell, r, metric)].mean) for cell, r, _ in tested]
     within = holm([d.p_below(bound) for (_, _, d), bound in zip(tested, bounds)])
     beyond = holm([d.p_above(bound) for (_, _, d), bound in zip(tested, bounds)])
