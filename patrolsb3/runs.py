@@ -56,10 +56,11 @@ class ConfigError(ValueError):
 CONFIG_SCHEMA = {"map": str, "map_source": str, "map_text": str, "map_shape": list, "variant": str, "algo": str, "seed": int,
                  "timesteps": int, "env": dict, "hyperparams": dict, "versions": dict, "init_from": dict,
                  "env_version": str, "date": str, "source_model": str, "source_run": str, "budget": dict,
-                 "recipe": str}
+                 "recipe": str, "precision_changes": list}
 """The keys a run's (or a zoo entry's) config.yml may hold, with their types: the train's own
-(map .. versions, init_from for a warm start, recipe: the ``--recipe`` it was given) and those
-``zoo export`` adds."""
+(map .. versions, init_from for a warm start, recipe: the ``--recipe`` it was given,
+precision_changes: the resumes that went on in another precision, each ``{timesteps,
+precision, why}``) and those ``zoo export`` adds."""
 
 
 def read_config(path: Path) -> dict:
@@ -418,6 +419,13 @@ class RunFolder:
         text = yaml.safe_dump(config, sort_keys=False)
         write_atomically(self.config_file, lambda partial: partial.write_text(text))
 
+    def record_precision_change(self, change: dict) -> None:
+        """Add ``{timesteps, precision, why}`` to config.yml's ``precision_changes``: from those
+        agent-steps on, the run trained in that precision."""
+        config = self.read_config()
+        config["precision_changes"] = (config.get("precision_changes") or []) + [change]
+        self.write_config(config)
+
     def record_command(self, command: str) -> None:
         """Append a command line to command.txt (atomically)."""
         import shutil
@@ -432,9 +440,15 @@ class RunFolder:
     # -- records -------------------------------------------------------------------------------
     def cut_back_to(self, timesteps: int) -> None:
         """Cut curve.csv, eval.csv and cpu_time.csv back to the rows at or before ``timesteps``
-        (the checkpoint a resume starts from): the abandoned stretch after it goes."""
+        (the checkpoint a resume starts from), and config.yml's ``precision_changes`` to those
+        before it: the abandoned stretch after it goes."""
         for name in self.RECORDS:
             trim_rows(self.path / name, timesteps)
+        config = self.read_config()
+        changes = config.get("precision_changes") or []
+        if any(c["timesteps"] >= timesteps for c in changes):
+            config["precision_changes"] = [c for c in changes if c["timesteps"] < timesteps]
+            self.write_config(config)
 
 
 class ZooEntry(RunFolder):

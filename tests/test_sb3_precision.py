@@ -114,7 +114,8 @@ def tiny_hp(**extra):
             **extra}
 
 
-def test_a_run_records_its_precision_and_resume_keeps_it(tmp_path, capsys):
+def test_a_run_records_its_precision_and_resume_keeps_it(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(precision_module, "cpu_info", lambda: {"name": "x", "native_bf16": True, "bf16_flags": []})
     run = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(precision="bf16"), progress_bar=False)
     assert RunFolder(run).read_config()["hyperparams"]["precision"] == "bf16"
     train(map=ROOM, timesteps=800, out=tmp_path, hyperparams=tiny_hp(precision="fp32"), resume=True,
@@ -128,6 +129,27 @@ def test_a_run_records_its_precision_and_resume_keeps_it(tmp_path, capsys):
     train(map=ROOM, timesteps=1200, out=tmp_path, hyperparams=tiny_hp(precision="bf16"), resume=True,
           progress_bar=False)
     assert "keeps the precision it was trained with (fp32), not bf16" in capsys.readouterr().err
+
+
+def test_a_bf16_run_resumed_without_native_bf16_goes_on_in_fp32_and_says_from_when(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(precision_module, "cpu_info", lambda: {"name": "x", "native_bf16": True, "bf16_flags": []})
+    run = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(precision="auto"), progress_bar=False)
+    assert RunFolder(run).read_config()["hyperparams"]["precision"] == "bf16"
+    monkeypatch.setattr(precision_module, "cpu_info", lambda: {"name": "y", "native_bf16": False, "bf16_flags": []})
+    train(map=ROOM, timesteps=800, out=tmp_path, hyperparams=tiny_hp(precision="auto"), resume=True, progress_bar=False)
+    assert "was trained in bf16 so far and goes on in fp32: this machine has no native bf16" in capsys.readouterr().err
+    changes = RunFolder(run).read_config()["precision_changes"]
+    assert [(c["timesteps"], c["precision"]) for c in changes] == [(400, "fp32")]
+    # resumed again here: it is an fp32 run now, nothing more to record
+    train(map=ROOM, timesteps=1200, out=tmp_path, hyperparams=tiny_hp(precision="auto"), resume=True, progress_bar=False)
+    assert "goes on in" not in capsys.readouterr().err
+    assert len(RunFolder(run).read_config()["precision_changes"]) == 1
+    # bf16 asked for explicitly keeps bf16, emulated or not
+    assert precision_module.resumed_precision("bf16", "bf16") == ("bf16", "")
+    assert precision_module.resumed_precision("fp32", "auto") == ("fp32", "")
+    # a resume from a checkpoint before the change drops it (the stretch after it is gone)
+    RunFolder(run).cut_back_to(400)
+    assert RunFolder(run).read_config()["precision_changes"] == []
 
 
 def test_a_bad_precision_is_refused_before_a_run_folder_exists(tmp_path):

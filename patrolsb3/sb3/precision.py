@@ -70,6 +70,27 @@ def resolve_precision(precision: str, device: str = "cpu") -> str:
     return precision
 
 
+def resumed_precision(recorded: str, asked: str, device: str = "cpu") -> tuple[str, str]:
+    """The precision a resumed run goes on in, and why it changed ("" when it did not).
+
+    A run keeps the precision it recorded, with one exception: a bf16 run resumed where bf16 is
+    not native (a CPU without ``avx512_bf16`` / ``amx_bf16`` / Arm ``bf16``) goes on in fp32
+    unless ``bf16`` is asked for explicitly. Emulated bf16 is several times slower than fp32 (on
+    the 2-core AMD EPYC without AVX512-BF16, one paper-recipe update took more than four times
+    its native time), and bf16 and fp32 learn alike (docs/training.md, "Precision").
+
+    Args:
+        recorded: the precision in the run's config.yml (``fp32`` or ``bf16``).
+        asked: this call's ``precision`` hyperparameter (``auto``, ``fp32`` or ``bf16``).
+        device: the torch device type the networks train on.
+    """
+    device = str(device).split(":")[0]
+    native = device == "cuda" or cpu_info()["native_bf16"]
+    if recorded == "bf16" and not native and asked != "bf16":
+        return "fp32", "this machine has no native bf16 (emulated bf16 is several times slower; bf16 and fp32 learn alike)"
+    return recorded, ""
+
+
 def autocast(precision: str, device_type: str):
     """The context the networks' trunks run in: bf16 autocast for ``bf16``, nothing for ``fp32``.
 

@@ -30,7 +30,7 @@ from .cpu_time import CpuTimeCallback, cpu_hours_of, read_rows, restart_at
 from .curriculum import CURRICULUM, CurriculumCallback
 from .hyperparams import load_hyperparams, merge, per_phase, schedule
 from .policy import policy_kwargs_for
-from .precision import PRECISIONS, resolve_precision
+from .precision import PRECISIONS, resolve_precision, resumed_precision
 from .variants import variant_overrides
 from .vec_env import DEFAULT_AGENTS, make_vec_env, training_config
 
@@ -320,19 +320,39 @@ def _check_resumable(run: RunFolder, config: dict) -> Path:
     return checkpoint
 
 
-def run_precision(hp: dict, device_type: str, resumed: RunFolder | None = None) -> str:
-    """The precision (``fp32`` or ``bf16``) a run trains with: its ``precision`` hyperparameter
-    resolved on this device (:func:`patrolsb3.sb3.precision.resolve_precision`); a resumed run
-    keeps the one its config.yml records (``fp32`` when it records none: runs from before the
-    setting existed), and says so on stderr when the hyperparameters asked for another."""
-    wanted = resolve_precision(hp.get("precision", "auto"), device_type)
+def run_precision(hp: dict, device_type: str, resumed: RunFolder | None = None,
+                  at_timesteps: int = 0) -> tuple[str, str]:
+    """The precision (``fp32`` or ``bf16``) a run trains with, and why a resumed run changed it.
+
+    A new run: its ``precision`` hyperparameter resolved on this device
+    (:func:`patrolsb3.sb3.precision.resolve_precision`). A resumed run keeps the one its
+    config.yml records (``fp32`` when it records none: runs from before the setting existed) and
+    says so on stderr when the hyperparameters asked for another, except a bf16 run on a machine
+    without native bf16, which goes on in fp32
+    (:func:`patrolsb3.sb3.precision.resumed_precision`); config.yml records such a change, and
+    the run's precision at ``at_timesteps`` (the checkpoint it resumes from) is the latest change
+    before it.
+
+    Returns:
+        (precision, why it changed on this resume; "" when it did not).
+    """
+    asked = hp.get("precision", "auto")
+    wanted = resolve_precision(asked, device_type)
     if resumed is None or not resumed.config_file.is_file():
-        return wanted
-    kept = (resumed.read_config().get("hyperparams") or {}).get("precision", "fp32")
-    if kept != wanted:
-        print(f"--resume: {resumed.path} keeps the precision it was trained with ({kept}), not {wanted}",
+        return wanted, ""
+    recorded = resumed.read_config()
+    kept = (recorded.get("hyperparams") or {}).get("precision", "fp32")
+    for change in recorded.get("precision_changes") or []:       # the latest change before the checkpoint
+        if change["timesteps"] < max(at_timesteps, 1):
+            kept = change["precision"]
+    used, why = resumed_precision(kept, asked, device_type)
+    if why:
+        print(f"--resume: {resumed.path} was trained in {kept} so far and goes on in {used}: {why}; "
+              f"config.yml records the change (precision_changes)", file=sys.stderr)
+    elif used != wanted:
+        print(f"--resume: {resumed.path} keeps the precision it was trained with ({used}), not {wanted}",
               file=sys.stderr)
-    return kept
+    return used, why
 
 
 def mixed_episodes(hp: dict, n_episodes: int) -> dict:
@@ -502,8 +522,13 @@ def train(map="A", variant: str = "rl-msg", timesteps: int | None = None, out="r
         checkpoint = None
     model, vec_env = _build_model(spec_map, variant, spec, hp, seed, start_teams, checkpoint, warm_weights,
                                   config, run, device, verbose)
-    model.policy.precision = run_precision(hp, model.device.type, run if checkpoint is not None else None)
+    model.policy.precision, precision_change = run_precision(hp, model.device.type,
+                                                             run if checkpoint is not None else None,
+                                                             at_timesteps=model.num_timesteps)
     config["hyperparams"] = {**hp, "precision": model.policy.precision}
+    if precision_change:
+        config["precision_change"] = {"timesteps": int(model.num_timesteps), "precision": model.policy.precision,
+                                      "why": precision_change}
     # every setting has been accepted (the model is built): now the run folder is made, and held
     folder_lock = run.lock()
     try:
@@ -524,6 +549,8 @@ def _train_in_folder(run: RunFolder, model, vec_env, checkpoint, resume: bool, c
     run.create()
     if checkpoint is not None:
         run.cut_back_to(model.num_timesteps)    # the abandoned stretch after the checkpoint goes
+        if "precision_change" in config:        # a resumed run changed precision: config.yml says from when
+            run.record_precision_change(config.pop("precision_change"))
     else:
         run.write_config(config)
     run.record_command(command or " ".join(sys.argv))
