@@ -2,9 +2,9 @@
 size), the figures already stored for them, and evaluating the rest here or on Ray.
 
 A cell's stored figures come from one lookup (:class:`StoredResults`) over the two places a
-comparison keeps them: a learned column's from its zoo entries' ``eval.json`` (the paper's
-setting: every training seed with this protocol, pooled with the seed as the unit; behind the
-return guard: the entry's own), a heuristic's from the comparison's ``results.json``
+comparison keeps them: a learned column's from its zoo entries' ``eval.json`` (the main zoo
+or a recipe shelf: every training seed with this protocol, pooled with the seed as the unit;
+behind the return guard: the entry's own), a heuristic's from the comparison's ``results.json``
 (:class:`~patrolsb3.result_store.ResultStore`). Zoo figures are never taken from
 ``results.json``: a model's weights can change under the same name.
 """
@@ -18,7 +18,7 @@ from . import zoo
 from .core.maps import load_map
 from .distributed import connect, evaluate_on_ray
 from .evaluate import evaluate, evaluation_setup, request_of
-from .names import canonical_name, is_learned
+from .names import SHELVES, canonical_name, is_learned
 from .report import EXTRA_COLUMNS, ZOO_COLUMNS
 from .result_store import ResultStore
 from .strategies import REGISTRY
@@ -78,18 +78,18 @@ def plan_cells(maps: list[str], sizes: list[int], strategies: list[str] | None,
     for name in asked:
         if not is_learned(name) and name not in REGISTRY:
             raise ValueError(f"unknown strategy {name!r}; known: {', '.join(REGISTRY)}, zoo:<variant> "
-                             f"or zoo:<variant>:guarded")
+                             f"or zoo:<variant>:<shelf> (shelves: {', '.join(SHELVES)})")
         if is_learned(name):
-            variant, guard = zoo.parse_strategy(name)
-            missing = [m for m in maps if not zoo.available(m, variant, guard=guard)]
+            variant, shelf = zoo.parse_strategy(name)
+            missing = [m for m in maps if not zoo.available(m, variant, shelf=shelf)]
             if missing:
                 raise ValueError(f"{name}: no zoo model for map(s) {', '.join(missing)}"
-                                 + ("" if guard else " in the paper's setting"))
+                                 + (f" on the shelf {shelf!r}" if shelf else " in the main zoo"))
     cells = [(m, name, n) for m in maps for name in (asked or default_strategies(m, say)) for n in sizes]
     for m, name in dict.fromkeys((m, name) for m, name, _ in cells if is_learned(name)):
-        variant, guard = zoo.parse_strategy(name)
-        if not guard:          # several seeds and no default.yml: one line saying how to choose
-            zoo.default_seed(m, variant)
+        variant, shelf = zoo.parse_strategy(name)
+        if shelf != zoo.GUARDED:          # several seeds and no default.yml: one line saying how to choose
+            zoo.default_seed(m, variant, shelf=shelf)
     return cells
 
 
@@ -124,13 +124,13 @@ class StoredResults:
         if is_learned(name):
             if self.rerun_zoo:
                 return None, ""
-            variant, guard = zoo.parse_strategy(name)
-            if guard:
+            variant, shelf = zoo.parse_strategy(name)
+            if shelf == zoo.GUARDED:
                 r = zoo.cached_result(m, variant, n, p.episodes, p.steps, p.seed, p.tests,
-                                      deterministic=p.deterministic, guard=True)
-            else:                 # the paper's setting: every seed with this protocol, pooled
+                                      deterministic=p.deterministic, shelf=shelf)
+            else:                 # the main zoo or a recipe shelf: every seed with this protocol, pooled
                 r = zoo.pooled_result(m, variant, n, p.episodes, p.steps, p.seed, p.tests,
-                                      deterministic=p.deterministic)
+                                      deterministic=p.deterministic, shelf=shelf)
                 if r is not None:
                     self.pooled[(m.upper(), name)] = (r["training_seeds"], r["unpooled_seeds"])
             source = "  (from the zoo's eval.json; --rerun-zoo to run it)"
@@ -183,13 +183,13 @@ def evaluate_cells(cells: list[Cell], protocol: Protocol, progress: bool = True,
 
 
 def learning_curves(cells: list[Cell]) -> dict:
-    """{MAP: {variant (or variant:guarded): [curve.csv of every training seed]}} of the zoo
+    """{MAP: {variant (or variant:shelf): [curve.csv of every training seed]}} of the zoo
     columns among ``cells`` (the report's training figure)."""
     curves = {}
     for m, name, _ in cells:
         if is_learned(name):
-            variant, guard = zoo.parse_strategy(name)
-            if found := zoo.seed_curves(m, variant, guard=guard):
+            variant, shelf = zoo.parse_strategy(name)
+            if found := zoo.seed_curves(m, variant, shelf=shelf):
                 curves.setdefault(m.upper(), {})[name[4:]] = found
     return curves
 
@@ -199,13 +199,13 @@ def zoo_note(map_name: str, strategy: str, reused: bool, pooled=None) -> str:
     which training seeds its figures are (pooled: ``(seeds pooled, seeds left out)``), whether
     they were reused from the entries' eval.json or computed now, and the recipe the seeds were
     trained with (:func:`patrolsb3.zoo.trained_with`)."""
-    variant, guard = zoo.parse_strategy(strategy)
-    folder = zoo.entry_dir(map_name, variant, guard=guard)
+    variant, shelf = zoo.parse_strategy(strategy)
+    folder = zoo.entry_dir(map_name, variant, shelf=shelf)
     config = zoo.read_entry(folder)["config"]
     guarded = bool((config.get("env") or {}).get("return_guard"))
     setting = ("behind the return guard (env.return_guard, ours: the heuristics' recharge rule as a "
                "shield)" if guarded else "the paper's setting (no return guard)")
-    if guard:
+    if shelf == zoo.GUARDED:
         which = ""
     elif pooled and len(pooled[0]) > 1:
         which = (f"training seeds {', '.join(map(str, pooled[0]))} pooled (the figure is the mean of the "
@@ -213,16 +213,16 @@ def zoo_note(map_name: str, strategy: str, reused: bool, pooled=None) -> str:
                  f"episodes, exact); ")
     else:
         shown = pooled[0][0] if pooled else config.get("seed", "?")
-        which = f"training seed {shown} ({default_reason(map_name, variant)}); "
+        which = f"training seed {shown} ({default_reason(map_name, variant, shelf)}); "
     if pooled and pooled[1]:
         which += (f"seed{'s' if len(pooled[1]) > 1 else ''} {', '.join(map(str, pooled[1]))} left out (no "
                   f"eval.json with per-episode figures for this protocol: 'patrolsb3 zoo eval'); ")
     return (f"{setting}; {which}figures {'reused from the eval.json' if reused else 'computed now'}; "
-            f"trained with {zoo.trained_with(map_name, variant, guard=guard)}")
+            f"trained with {zoo.trained_with(map_name, variant, shelf=shelf)}")
 
 
-def default_reason(map_name: str, variant: str) -> str:
-    """Why the paper-setting entry's default seed is the default, for the report."""
-    chosen = zoo.default_seed(map_name, variant) or {}
-    have = zoo.seeds(map_name, variant)
+def default_reason(map_name: str, variant: str, shelf: str = "") -> str:
+    """Why the entry's default seed (the main zoo's or a recipe shelf's) is the default, for the report."""
+    chosen = zoo.default_seed(map_name, variant, shelf=shelf) or {}
+    have = zoo.seeds(map_name, variant, shelf=shelf)
     return f"{chosen.get('chosen_by', '?')}; the entry has {len(have)} seed{'s' if len(have) != 1 else ''}"

@@ -5,8 +5,8 @@ All episodes of one configuration (tests x episodes) step together on the batche
 ``policy.predict(sim_state, memory, episode_start)`` -> actions (E, A, 2), then
 ``core.step(spec, cfg, sim, actions[..., 1], messages=actions[..., 0], compute_reward=False)``
 with ``invalid_action='raise'``. A heuristic (``patrolsb3.strategies``) and a zoo model
-(``zoo:<variant>``, loaded by ``patrolsb3.zoo.load(map, variant)``; ``zoo:<variant>:guarded`` for
-the entries behind the return guard) are treated the same way.
+(``zoo:<variant>``, loaded by ``patrolsb3.zoo.load(map, variant)``; ``zoo:<variant>:<shelf>`` for
+an entry on a shelf of the zoo, e.g. behind the return guard) are treated the same way.
 
 Tests: episode e belongs to test ``e // episodes`` (:func:`patrolsb3.summary.summarize`).
 """
@@ -29,7 +29,8 @@ from .summary import summarize
 
 def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0, device: str = "cpu"):
     """A heuristic by name, or ``zoo:<variant>`` through ``patrolsb3.zoo.load(map, variant)``
-    (``zoo:<variant>:guarded``: the entry behind the return guard; its network on ``device``:
+    (``zoo:<variant>:<shelf>``: the entry on that shelf of the zoo, e.g. ``zoo:rl-msg:guarded``
+    behind the return guard; its network on ``device``:
     auto, cpu or cuda).
 
     Raises:
@@ -37,8 +38,8 @@ def load_policy(name: str, spec, n_agents: int, cfg, seed: int = 0, device: str 
     """
     if is_learned(name):
         try:
-            variant, guard = zoo.parse_strategy(name)
-            return zoo.load(spec.name, variant, spec=spec, device=device, guard=guard)
+            variant, shelf = zoo.parse_strategy(name)
+            return zoo.load(spec.name, variant, spec=spec, device=device, shelf=shelf)
         except (ValueError, FileNotFoundError) as exc:
             raise ValueError(f"strategy {name!r}: {exc}") from exc
     return strategies.get(name, spec, n_agents, cfg=cfg, seed=seed)
@@ -105,7 +106,7 @@ def evaluate(strategy: str, map_name="A", n_agents: int = 3, episodes: int = 100
     """Evaluate one strategy on one map and team size (the ``patrolsb3 evaluate`` command).
 
     Args:
-        strategy: RANDOM, CR, PART, SEBS, CYCLIC, zoo:<variant> or zoo:<variant>:guarded.
+        strategy: RANDOM, CR, PART, SEBS, CYCLIC, zoo:<variant> or zoo:<variant>:<shelf>.
         map_name: a shipped map name or a map file.
         n_agents: team size.
         episodes: episodes per test.

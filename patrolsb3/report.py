@@ -23,7 +23,7 @@ import numpy as np
 from .claims import PAIRED_METRICS, claims, claims_table, read_figures
 from .core.streams import STREAMS_VERSION
 from .learning_curves import plot_learning_curves
-from .names import CSV_COLUMNS, VARIANT_NAMES, display_name, is_learned, strategy_name
+from .names import CSV_COLUMNS, SHELVES, VARIANT_NAMES, display_name, is_learned, shelf_column, strategy_name
 from .runs import ComparisonFolder
 
 PAPER_TABLES = {"BF": "battery_failure_rate", "BLv": "swap_battery_pct", "MAX": "max_idleness",
@@ -33,8 +33,10 @@ PAPER_COLUMNS = ("CR", "PART", "SEBS", "INTENTION", "NOMSG", "MSG")
 EXTRA_COLUMNS = ("RANDOM", "CYCLIC")
 ZOO_COLUMNS = {column: strategy_name(CSV_COLUMNS[column]) for column in ("INTENTION", "NOMSG", "MSG")}
 """Paper column -> strategy name that fills it (the zoo entries in the paper's setting)."""
-GUARDED_COLUMNS = {f"{column}-GUARDED": strategy_name(CSV_COLUMNS[column], guard=True) for column in ZOO_COLUMNS}
-"""Extra columns of the entries behind the return guard, present only when a comparison has them."""
+SHELF_COLUMNS = {shelf_column(column, shelf): strategy_name(CSV_COLUMNS[column], shelf)
+                 for shelf in SHELVES for column in ZOO_COLUMNS}
+"""Extra columns of the entries on the zoo's shelves (``MSG-GUARDED``, ``MSG-PAPER-RECIPE``, ...),
+present only when a comparison has them."""
 LABELS = {"avg_idleness": "AVG^h", "max_idleness": "MAX^h", "worst_idleness": "worst idleness",
           "std_idleness": "std across vertices", "collisions": "collisions / episode",
           "battery_failures": "battery failures / episode",
@@ -43,7 +45,7 @@ LABELS = {"avg_idleness": "AVG^h", "max_idleness": "MAX^h", "worst_idleness": "w
 
 def column_strategy(column: str) -> str:
     """Strategy name behind a table column (heuristic names are their own)."""
-    return ZOO_COLUMNS.get(column, GUARDED_COLUMNS.get(column, column))
+    return ZOO_COLUMNS.get(column, SHELF_COLUMNS.get(column, column))
 
 
 def mean_std(stat: dict, digits: int = 1) -> str:
@@ -173,7 +175,7 @@ def write_compare(results: list[dict], out_dir, plots: bool = True, learning_cur
             if zoo_notes:
                 md.append("")
     strategies = {r.get("strategy") for r in results}
-    extra_columns = EXTRA_COLUMNS + tuple(c for c, s in GUARDED_COLUMNS.items() if s in strategies)
+    extra_columns = EXTRA_COLUMNS + tuple(c for c, s in SHELF_COLUMNS.items() if s in strategies)
     for m in maps:
         for suffix, metric in PAPER_TABLES.items():
             md += [f"## Map {m}: {suffix} ({LABELS[metric]})", ""]

@@ -207,7 +207,7 @@ def test_the_command_on_a_comparison_and_its_refusals(tmp_path, capsys):
 
 def test_claims_on_the_guarded_entries_only_when_asked(tmp_path, capsys):
     from patrolsb3 import zoo
-    if not zoo.available("A", "rl-msg", guard=True):
+    if not zoo.available("A", "rl-msg", shelf="guarded"):
         pytest.skip("needs the zoo's guarded A/rl-msg")
     assert cli.main(["compare", "--maps", "A", "--agents", "1", "--strategies", "CR,SEBS,zoo:rl-msg:guarded",
                      "--episodes", "1", "--steps", "40", "--no-progress", "--rerun-zoo", "--out", str(tmp_path / "g")]) == 0

@@ -108,7 +108,7 @@ def test_cli_compare_stochastic_samples_the_zoo_model(tmp_path):
     assert greedy[0]["deterministic"] == "True" and sampled[0]["deterministic"] == "False"
 
 
-@pytest.mark.skipif(not zoo.available("A", "rl-msg", guard=True), reason="needs the zoo's guarded A/rl-msg")
+@pytest.mark.skipif(not zoo.available("A", "rl-msg", shelf="guarded"), reason="needs the zoo's guarded A/rl-msg")
 def test_compare_shows_the_guarded_entries_only_when_asked_and_labelled(tmp_path, capsys):
     assert cli.main(["compare", "--maps", "A", "--agents", "1", "--episodes", "1", "--steps", "30",
                      "--strategies", "CR,zoo:rl-msg:guarded", "--out", str(tmp_path / "g"), "--no-progress"]) == 0
@@ -120,7 +120,28 @@ def test_compare_shows_the_guarded_entries_only_when_asked_and_labelled(tmp_path
     assert "map A, zoo:rl-msg:guarded: behind the return guard" in report and "| RL-MSG (guarded) |" in report
     assert cli.main(["compare", "--maps", "A", "--agents", "1", "--episodes", "1", "--steps", "5",
                      "--strategies", "zoo:rl-msg:shielded", "--out", str(tmp_path / "bad")]) == 2
-    assert "unknown suffix 'shielded'" in capsys.readouterr().err and not (tmp_path / "bad").exists()
+    assert "shelf 'shielded': not a shelf of the zoo" in capsys.readouterr().err and not (tmp_path / "bad").exists()
+
+
+@pytest.mark.skipif(not zoo.available("A", "rl-msg"), reason="needs the zoo's A/rl-msg")
+def test_compare_shows_a_recipe_shelf_as_its_own_labelled_column(tmp_path, capsys, monkeypatch):
+    import shutil
+    source = zoo.entry_dir("A", "rl-msg", seed=0)
+    for place in ("A/rl-msg/seed0", "paper-recipe/A/rl-msg/seed0"):       # a zoo of one entry, shelved once
+        shutil.copytree(source, tmp_path / "zoo" / place, ignore=shutil.ignore_patterns("eval.json"))
+    monkeypatch.setenv(zoo.ZOO_ENV, str(tmp_path / "zoo"))
+    assert cli.main(["compare", "--maps", "A", "--agents", "1", "--episodes", "1", "--steps", "30",
+                     "--strategies", "CR,zoo:rl-msg,zoo:rl-msg:paper-recipe", "--out", str(tmp_path / "c"),
+                     "--no-progress"]) == 0
+    extra = list(csv.reader((tmp_path / "c" / "A-MAX-extra.csv").open()))
+    main = list(csv.reader((tmp_path / "c" / "A-MAX.csv").open()))
+    assert extra[0] == ["n", "RANDOM", "CYCLIC", "MSG-PAPER-RECIPE"]
+    assert extra[1][3] == main[1][main[0].index("MSG")] != ""      # the same weights: the same figures
+    report = (tmp_path / "c" / "report.md").read_text()
+    assert "| RL-MSG (paper recipe) |" in report and "map A, zoo:rl-msg:paper-recipe: the paper's setting" in report
+    assert cli.main(["compare", "--maps", "A", "--agents", "1", "--episodes", "1", "--steps", "5",
+                     "--strategies", "zoo:rl-msg:cd10", "--out", str(tmp_path / "bad")]) == 2
+    assert "no zoo model for map(s) A on the shelf 'cd10'" in capsys.readouterr().err
 
 
 def test_faults_outside_the_episode_are_refused():

@@ -235,7 +235,7 @@ def test_a_model_trained_behind_the_return_guard_acts_behind_it(trained, tmp_pat
     config = yaml.safe_load(path.read_text())
     config["env"]["return_guard"] = True
     path.write_text(yaml.safe_dump(config))
-    with pytest.raises(zoo.ZooError, match="in the paper's setting .*the zoo has: ROOM/rl-msg:guarded"):
+    with pytest.raises(zoo.ZooError, match="in the main zoo .*the zoo has: ROOM/rl-msg:guarded"):
         zoo.load("ROOM", "rl-msg", zoo_dir=tmp_path / "zoo", spec=trained["map_file"])   # the default is not the shield
     guarded = zoo.load("ROOM", "rl-msg", zoo_dir=tmp_path / "zoo", spec=trained["map_file"], guard=True)
     plain = zoo.load("ROOM", "rl-msg", zoo_dir=trained["root"] / "zoo", spec=trained["map_file"])
@@ -323,14 +323,60 @@ def test_seeds_of_an_entry_and_the_default_chosen_by_validation(trained, tmp_pat
         zoo.load("ROOM", "rl-msg", zoo_dir=copy, spec=trained["map_file"])
 
 
-def test_strategy_names_select_the_setting():
-    assert zoo.parse_strategy("zoo:rl-msg") == ("rl-msg", False)
-    assert zoo.parse_strategy("ZOO:RL-MSG:guarded") == ("rl-msg", True)
-    assert zoo.strategy_name("rl-no-msg", guard=True) == "zoo:rl-no-msg:guarded"
-    for bad, why in (("zoo:rl-msg:shielded", "unknown suffix"), ("zoo:telepathy", "unknown variant"),
+def test_strategy_names_select_the_shelf():
+    assert zoo.parse_strategy("zoo:rl-msg") == ("rl-msg", "")
+    assert zoo.parse_strategy("ZOO:RL-MSG:guarded") == ("rl-msg", "guarded")
+    assert zoo.strategy_name("rl-no-msg", "guarded") == "zoo:rl-no-msg:guarded"
+    for bad, why in (("zoo:rl-msg:shielded", "not a shelf of the zoo"), ("zoo:telepathy", "unknown variant"),
                      ("CR", "not a zoo strategy")):
         with pytest.raises(zoo.ZooError, match=why):
             zoo.parse_strategy(bad)
+
+
+def test_an_entry_on_a_recipe_shelf_is_its_own_column_beside_the_main_zoo(trained, tmp_path, capsys):
+    from patrolsb3 import cli
+    from patrolsb3.zoo.cards import entry_name, load_line
+    from patrolsb3.zoo.evaluation import write_zoo_eval
+    root = tmp_path / "zoo"
+    shutil.copytree(trained["root"] / "zoo", root)
+    folder = zoo.export(trained["run"], zoo_dir=root, budget={"cpu_hours": 0.001}, shelf="paper-recipe")
+    assert folder == root / "paper-recipe" / "ROOM" / "rl-msg" / "seed0"
+    assert zoo.seeds("ROOM", "rl-msg", root, shelf="paper-recipe") == [0]
+    assert not zoo.available("ROOM", "rl-msg", root, shelf="cd10")
+    shelved = zoo.load("ROOM", "rl-msg", zoo_dir=root, spec=trained["map_file"], shelf="paper-recipe")
+    assert Path(shelved.info["path"]) == folder
+    assert Path(zoo.load("ROOM", "rl-msg", zoo_dir=root, spec=trained["map_file"]).info["path"]) == root / "ROOM" / "rl-msg" / "seed0"
+    assert zoo.trained_with("ROOM", "rl-msg", root, shelf="paper-recipe").endswith(": seed 0")
+    results = json.loads(write_zoo_eval(folder, episodes=1, steps=20, progress=False).read_text())
+    assert results["strategy"] == "zoo:rl-msg:paper-recipe"                  # the eval.json says which column
+    entries = {(e["shelf"], e["seed"]) for e in zoo.list_entries(root)}
+    assert entries == {("", 0), ("paper-recipe", 0)}
+    shelf_entry = next(e for e in zoo.list_entries(root) if e["shelf"])
+    assert entry_name(shelf_entry) == "paper-recipe/room/rl-msg/seed0"              # the map as config.yml names it
+    assert "shelf='paper-recipe', seed=0" in load_line(shelf_entry) and "zoo:rl-msg:paper-recipe" in load_line(shelf_entry)
+    with pytest.raises(zoo.ZooError, match="--shelf guarded: .* without the return guard"):
+        zoo.export_destination(trained["run"], zoo_dir=root, shelf="guarded")
+    with pytest.raises(zoo.ZooError, match="--shelf 'e2': not a shelf of the zoo"):
+        zoo.export_destination(trained["run"], zoo_dir=root, shelf="e2")
+    with pytest.raises(zoo.ZooError, match="no zoo model .* on the shelf 'cd10'"):
+        zoo.load("ROOM", "rl-msg", zoo_dir=root, shelf="cd10")
+    assert cli.main(["zoo", "show", "room", "rl-msg", "--zoo-dir", str(root), "--shelf", "paper-recipe"]) == 0
+    assert "paper-recipe" in json.loads(capsys.readouterr().out)["path"]
+    assert cli.main(["zoo", "show", "room", "rl-msg", "--zoo-dir", str(root), "--shelf", "cd10", "--guarded"]) == 2
+    assert "--guarded and --shelf cd10" in capsys.readouterr().err
+
+
+def test_claims_on_a_shelf_put_its_columns_in_place_of_the_main_zoos():
+    from patrolsb3.commands.claims import on_shelf
+    from patrolsb3.report import column_strategy
+    figures = {("A", 3, name, "collisions"): name for name in
+               ("CR", "zoo:rl-msg", "zoo:rl-no-msg", "zoo:rl-msg:paper-recipe", "zoo:rl-msg:guarded")}
+    assert on_shelf(figures, "") == {("A", 3, n, "collisions"): n for n in ("CR", "zoo:rl-msg", "zoo:rl-no-msg")}
+    assert on_shelf(figures, "paper-recipe") == {("A", 3, "CR", "collisions"): "CR",
+                                                 ("A", 3, "zoo:rl-msg", "collisions"): "zoo:rl-msg:paper-recipe",
+                                                 ("A", 3, "zoo:rl-no-msg", "collisions"): "zoo:rl-no-msg"}
+    assert column_strategy("MSG-PAPER-RECIPE") == "zoo:rl-msg:paper-recipe"
+    assert column_strategy("NOMSG-GUARDED") == "zoo:rl-no-msg:guarded" and column_strategy("SEBS") == "SEBS"
 
 
 def test_config_files_are_read_through_a_schema(tmp_path):

@@ -31,7 +31,7 @@ def parse_faults(texts) -> tuple:
 def add_arguments(parser):
     parser.add_argument("--strategy", required=True,
                         help="RANDOM, CR, PART, SEBS, CYCLIC (case-insensitive), zoo:<variant> (the paper's setting) "
-                             "or zoo:<variant>:guarded (the entries behind the return guard)")
+                             "or zoo:<variant>:<shelf> (an entry on a shelf of the zoo: guarded, paper-recipe, cd10)")
     parser.add_argument("--map", default="A", help="map name A-D or a map file (default A)")
     parser.add_argument("--agents", type=int, default=3, help="team size (default 3)")
     parser.add_argument("--episodes", type=int, default=100, help="episodes per test (default 100)")

@@ -4,8 +4,9 @@ export RUN``: a run into the zoo; ``patrolsb3 zoo validate RUN``: rank a run's c
 ``patrolsb3 zoo listening MAP VARIANT``: what its messages carry (:mod:`patrolsb3.listening`);
 ``patrolsb3 zoo ablation MAP VARIANT``: what the team loses when it cannot trust them
 (:mod:`patrolsb3.ablation`); ``patrolsb3 zoo choose MAP VARIANT``: the default seed, by
-validation. MAP VARIANT means the paper's setting; ``--guarded`` the entries behind the return
-guard, ``--seed-of-entry K`` one training seed."""
+validation. MAP VARIANT means the main zoo; ``--shelf SHELF`` an entry on one of the zoo's
+shelves (``--guarded``: the entries behind the return guard), ``--seed-of-entry K`` one training
+seed."""
 import json
 import math
 from pathlib import Path
@@ -13,6 +14,7 @@ from pathlib import Path
 from ..ablation import ablation_table, message_ablation
 from ..listening import listening
 from ..locks import hold
+from ..names import SHELVES, shelf_option
 from ..outputs import check_output_dir, check_output_file, write_json
 from ..report import clean_figures
 from ..runs import ZooEntry, recorded_path
@@ -32,16 +34,25 @@ from ..zoo.validation import choose_default, rank, run_checkpoints, validate
 
 
 def add_entry_arguments(parser, variant_help: str | None = None) -> None:
-    """The arguments that pick one entry: MAP VARIANT, --zoo-dir, --guarded, --seed-of-entry K."""
+    """The arguments that pick one entry: MAP VARIANT, --zoo-dir, --shelf / --guarded, --seed-of-entry K."""
     parser.add_argument("map", help="the map the entry was trained on (A-D)")
     parser.add_argument("variant", help=variant_help or "rl-msg, rl-no-msg or rl-intention")
     parser.add_argument("--zoo-dir", default=None, help="another zoo folder (default: $PATROLSB3_ZOO, else the "
                                                         "checkout's zoo/)")
-    parser.add_argument("--guarded", action="store_true",
-                        help="the entry behind the return guard (zoo/guarded/), not the paper's setting")
+    add_shelf_arguments(parser)
     parser.add_argument("--seed-of-entry", type=int, default=None, dest="entry_seed", metavar="K",
                         help="the model of training seed K, zoo/MAP/VARIANT/seedK (zoo.load(..., seed=K) in "
                              "Python; --seed is the simulator's); default: the entry's default seed")
+
+
+def add_shelf_arguments(parser, guarded: bool = True) -> None:
+    """--shelf SHELF (and --guarded, short for --shelf guarded): an entry on a shelf of the zoo."""
+    parser.add_argument("--shelf", default="", metavar="SHELF",
+                        help=f"an entry on a shelf of the zoo, zoo/SHELF/ ({', '.join(SHELVES)}); default: the "
+                             f"main zoo")
+    if guarded:
+        parser.add_argument("--guarded", action="store_true",
+                            help="the entry behind the return guard (zoo/guarded/): --shelf guarded")
 
 
 def add_action(sub, name: str, help: str):
@@ -73,6 +84,7 @@ def add_arguments(parser):
     p_export.add_argument("--overwrite", action="store_true",
                           help="replace an existing entry (its model and every figure of it: eval, listening, "
                                "ablation); without it an existing entry is refused")
+    add_shelf_arguments(p_export, guarded=False)
     p_export.add_argument("--as-seed", action="store_true",
                           help="export into the entry's seed<k> subfolder (k: the run's seed), not its default")
     p_val = add_action(sub, "validate", help="evaluate every checkpoint of a run on a short greedy protocol "
@@ -95,6 +107,7 @@ def add_arguments(parser):
     p_choose.add_argument("map")
     p_choose.add_argument("variant")
     p_choose.add_argument("--zoo-dir", default=None)
+    add_shelf_arguments(p_choose, guarded=False)
     p_choose.add_argument("--agents", default="1,3,5", help="team sizes (default 1,3,5)")
     p_choose.add_argument("--episodes", type=int, default=4, help="episodes per team size (default 4)")
     p_choose.add_argument("--steps", type=int, default=3000, help="steps per episode (default 3000)")
@@ -142,12 +155,15 @@ def team_sizes(text) -> tuple[int, ...]:
 
 
 def chosen_entry(args):
-    """The entry folder MAP VARIANT [--guarded] [--seed-of-entry K] names; it must hold a model.
+    """The entry folder MAP VARIANT [--shelf SHELF | --guarded] [--seed-of-entry K] names; it must
+    hold a model.
 
     Raises:
         ZooError: no such entry or seed (:func:`patrolsb3.zoo.existing_entry_dir`).
+        ValueError: an unknown shelf, or --guarded with another shelf.
     """
-    return existing_entry_dir(args.map, args.variant, args.zoo_dir, seed=args.entry_seed, guard=args.guarded)
+    shelf = shelf_option(args.shelf, args.guarded)
+    return existing_entry_dir(args.map, args.variant, args.zoo_dir, seed=args.entry_seed, shelf=shelf)
 
 
 def run(args):
@@ -193,7 +209,8 @@ def run(args):
             if getattr(args, name) < 1:
                 raise ValueError(f"--{name} must be >= 1, got {getattr(args, name)}")
         chosen = choose_default(args.map, args.variant, zoo_dir=args.zoo_dir, team_sizes=team_sizes(args.agents),
-                                episodes=args.episodes, steps=args.steps, seed=args.seed)
+                                episodes=args.episodes, steps=args.steps, seed=args.seed,
+                                shelf=shelf_option(args.shelf, False))
         for row in chosen["validation"]:
             print(f"seed {row['seed']}: failures/episode {row['failures']:.2f}  BF rate {row['bf_rate']:.2f}  "
                   f"AVG^h {row['avg_idleness']:.1f}")
@@ -207,7 +224,8 @@ def run(args):
         c = e["config"]
         budget = c.get("budget", {})
         where = f"/seed{e['seed']}" if e["seed"] is not None else ""
-        print(f"{c.get('map', '?')}/{c.get('variant', '?')}{where}  algo {c.get('algo', '?')}  "
+        shelf = f"{e['shelf']}/" if e["shelf"] else ""
+        print(f"{shelf}{c.get('map', '?')}/{c.get('variant', '?')}{where}  algo {c.get('algo', '?')}  "
               f"env {c.get('env_version', '?')}  trained {c.get('date', '?')}  "
               f"{budget.get('timesteps', '?')} steps, {budget.get('cpu_hours', '?')} CPU h"
               + ("  behind the return guard (env.return_guard, ours)"
@@ -228,7 +246,7 @@ def export_and_evaluate(args) -> int:
         raise ValueError(f"--cpu-hours must be a number >= 0, got {args.cpu_hours}")
     if args.checkpoint is not None and not os.path.isfile(args.checkpoint):
         raise ValueError(f"--checkpoint {args.checkpoint}: no such file")
-    entry = export_destination(args.run_dir, zoo_dir=args.zoo_dir, as_seed=args.as_seed)
+    entry = export_destination(args.run_dir, zoo_dir=args.zoo_dir, as_seed=args.as_seed, shelf=args.shelf)
     entry.parent.mkdir(parents=True, exist_ok=True)
     lock = hold(entry.with_name(f".{entry.name}.lock"), f"{entry} is being exported by another process; wait for it to end")
     try:
@@ -239,7 +257,7 @@ def export_and_evaluate(args) -> int:
         budget = {"cpu_hours": args.cpu_hours} if args.cpu_hours is not None else {}
         try:
             export(args.run_dir, zoo_dir=args.zoo_dir, budget=budget, checkpoint=args.checkpoint,
-                   as_seed=args.as_seed, into=staged)
+                   as_seed=args.as_seed, into=staged, shelf=args.shelf)
             if not args.no_eval:
                 write_zoo_eval(staged, episodes=args.episodes, steps=args.steps, seed=args.seed,
                                deterministic=not args.stochastic)

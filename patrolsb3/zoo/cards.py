@@ -12,6 +12,7 @@ from ..outputs import read_json
 from ..report import ZOO_TABLE_METRICS, mean_std
 from ..runs import ZooEntry
 from .folders import list_entries
+from .results import recipe_of
 
 VARIANT_TEXT = {"rl-msg": "learned 16-symbol messages (RIAL)", "rl-no-msg": "positions only, no messages",
                 "rl-intention": "each agent announces its intended move (a fixed meaning)"}
@@ -30,19 +31,20 @@ def simulator_steps(config: dict, agent_steps: int) -> int:
 
 
 def entry_name(entry: dict) -> str:
-    """``A/rl-msg/seed0`` (paper's setting), ``guarded/A/rl-msg`` (behind the return guard)."""
+    """``A/rl-msg/seed0`` (the main zoo), ``paper-recipe/A/rl-msg/seed0`` (a shelf),
+    ``guarded/A/rl-msg`` (behind the return guard)."""
     c = entry["config"]
     name = f"{c.get('map')}/{c.get('variant')}" + (f"/seed{entry['seed']}" if entry.get("seed") is not None else "")
-    return f"guarded/{name}" if entry.get("guard") else name
+    return f"{entry['shelf']}/{name}" if entry.get("shelf") else name
 
 
 def load_line(entry: dict) -> str:
     """The line of Python that loads this entry, and its strategy name."""
     c = entry["config"]
-    extra = (", guard=True" if entry.get("guard") else "") + \
+    extra = (f", shelf={entry['shelf']!r}" if entry.get("shelf") else "") + \
         (f", seed={entry['seed']}" if entry.get("seed") is not None else "")
     return (f"policy = zoo.load({c.get('map')!r}, {c.get('variant')!r}{extra})        # evaluation: "
-            f"--strategy {strategy_name(c.get('variant'), bool(entry.get('guard')))}")
+            f"--strategy {strategy_name(c.get('variant'), entry.get('shelf', ''))}")
 
 
 METRIC_LABEL = {"avg_idleness": "AVG^h", "max_idleness": "MAX^h", "collisions": "collisions"}
@@ -137,6 +139,7 @@ def card(entry: dict) -> str:
              "- **setting**: " + ("**behind the return guard** (`env.return_guard`, ours: the heuristics' "
                                    "recharge rule as a shield on the moves; not the paper's setting)"
                                    if guarded else "the paper's setting (no return guard)"),
+             f"- **recipe**: {recipe_of(c)}; docs/training.md compares the recipes",
              f"- **observation**: messages `{env.get('message_encoding', 'scalar')}`, local idleness "
              f"{'on' if env.get('local_idleness') else 'off'}, difference-reward weight c_d = {env.get('c_d')}",
              f"- **budget**: {int(budget.get('timesteps', 0)):,} agent-steps (all stages), about "
@@ -176,8 +179,8 @@ def write_cards(out_dir, zoo_dir=None) -> list[Path]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     entries = list_entries(zoo_dir)
-    written, index = [], ["# Model cards", "", "| entry | variant | setting | agent-steps | CPU h |",
-                          "|---|---|---|---|---|"]
+    written, index = [], ["# Model cards", "", "| entry | variant | setting | recipe | agent-steps | CPU h |",
+                          "|---|---|---|---|---|---|"]
     for entry in entries:
         c = entry["config"]
         stem = entry_name(entry).replace("/", "-")
@@ -186,7 +189,7 @@ def write_cards(out_dir, zoo_dir=None) -> list[Path]:
         written.append(path)
         guarded = "return guard" if (c.get("env") or {}).get("return_guard") else "paper's"
         budget = c.get("budget") or {}
-        index.append(f"| [{entry_name(entry)}]({stem}.md) | {c.get('variant')} | {guarded} | "
+        index.append(f"| [{entry_name(entry)}]({stem}.md) | {c.get('variant')} | {guarded} | {recipe_of(c)} | "
                      f"{int(budget.get('timesteps', 0)):,} | {budget.get('cpu_hours', '?')} |")
     index += ["", "What the learned messages carry, every entry side by side: [messages.md](messages.md)."]
     (out / "index.md").write_text("\n".join(index) + "\n")

@@ -11,26 +11,34 @@ import yaml
 
 from ..core.config import ENV_VERSION
 from ..runs import RunFolder, ZooEntry, recorded_path, write_atomically
-from .folders import ZooError, entry_dir
+from ..names import GUARDED
+from .folders import ZooError, checked_shelf, entry_dir
 
 
-def export_destination(run_dir, zoo_dir=None, as_seed: bool = False) -> Path:
-    """The entry folder :func:`export` writes a run into (module docstring of :func:`export`).
+def export_destination(run_dir, zoo_dir=None, as_seed: bool = False, shelf: str = "") -> Path:
+    """The entry folder :func:`export` writes a run into (its docstring says which).
 
     Raises:
-        ZooError: the run folder has no config.yml.
+        ZooError: the run folder has no config.yml, an unknown shelf, or a shelf that does not
+            fit the run: a run behind the return guard goes to the shelf "guarded" and only
+            there.
     """
     run = RunFolder(run_dir)
     if not run.config_file.is_file():
         raise ZooError(f"{run.path}: no config.yml; not a run folder of 'patrolsb3 train'")
     config = run.read_config()
     guard = bool((config.get("env") or {}).get("return_guard"))
-    return entry_dir(config["map"], config["variant"], zoo_dir, guard=guard,
+    shelf = checked_shelf(shelf)
+    if shelf and (shelf == GUARDED) != guard:
+        raise ZooError(f"--shelf {shelf}: {run.path} was trained {'behind' if guard else 'without'} the return "
+                       f"guard; {'its shelf is ' + repr(GUARDED) if guard else 'the shelf ' + repr(GUARDED) + ' holds only runs behind it'}")
+    shelf = GUARDED if guard else shelf
+    return entry_dir(config["map"], config["variant"], zoo_dir, shelf=shelf,
                      seed=config.get("seed", 0) if as_seed or not guard else None)
 
 
 def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, as_seed: bool = False,
-           into=None) -> Path:
+           into=None, shelf: str = "") -> Path:
     """Copy a training run into the zoo, keeping the policy only (no optimizer).
 
     Args:
@@ -45,12 +53,14 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
         as_seed: for a run behind the return guard, write into the guarded entry's ``seed<k>``
             subfolder (k: the run's training seed) instead of its default folder. A run in the
             paper's setting always goes to ``zoo/<MAP>/<variant>/seed<k>/``.
+        shelf: a recipe shelf (:data:`patrolsb3.names.SHELVES`, e.g. ``"paper-recipe"``) to write
+            into, ``zoo/<shelf>/<MAP>/<variant>/seed<k>/``, instead of the main zoo.
         into: write into this folder instead (a staging folder: ``patrolsb3 zoo export`` builds
             the whole entry there, then swaps it in; :func:`replace_entry`).
 
     Returns:
-        The entry folder: ``zoo/<MAP>/<variant>/seed<k>`` for a run in the paper's setting (no
-        return guard), ``zoo/guarded/<MAP>/<variant>`` (or its ``seed<k>``) for a guarded one.
+        The entry folder: ``zoo/[<shelf>/]<MAP>/<variant>/seed<k>`` for a run in the paper's setting
+        (no return guard), ``zoo/guarded/<MAP>/<variant>`` (or its ``seed<k>``) for a guarded one.
 
     Raises:
         ZooError: the run folder lacks a model or a config.
@@ -67,7 +77,7 @@ def export(run_dir, zoo_dir=None, budget: dict | None = None, checkpoint=None, a
     from ..sb3.cpu_time import cpu_hours_of
     algo_class, _ = get_algorithm(config["algo"]).classes()
     model = algo_class.load(str(source), device="cpu")
-    folder = Path(into) if into is not None else export_destination(run_dir, zoo_dir, as_seed)
+    folder = Path(into) if into is not None else export_destination(run_dir, zoo_dir, as_seed, shelf)
     folder.mkdir(parents=True, exist_ok=True)
     write_atomically(ZooEntry(folder).model_file, lambda partial: model.policy.save(str(partial)))
     for name in (run.COMMAND, *run.RECORDS):

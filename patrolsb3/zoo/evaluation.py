@@ -13,6 +13,7 @@ from ..names import strategy_name
 from ..outputs import write_json
 from ..runs import ZooEntry
 from ..summary import summarize
+from .folders import shelf_of
 from .policy import evaluation_config, load_entry
 
 
@@ -48,7 +49,7 @@ def write_zoo_eval(folder, episodes: int = 10, steps: int = 14400, seed: int = 0
                                episode_ids=ids,
                                desc=f"zoo {config['map']}/{config['variant']} n=1..{max_agents}",
                                deterministic=deterministic)
-    strategy = strategy_name(config["variant"], guard=policy.cfg.return_guard)
+    strategy = strategy_name(config["variant"], shelf_of(folder))
     results = []
     for n in range(1, max_agents + 1):
         rows = team == n

@@ -1,15 +1,22 @@
 """The zoo's folders: where the zoo is, which folder holds which entry and seed, and reading an
 entry's files. No torch here: listing and reading entries is cheap.
 
-Two settings, two folders (the rule lives here, in :func:`entry_dir`):
+The main zoo and its shelves (:data:`patrolsb3.names.SHELVES`), each its own folder (the rule
+lives here, in :func:`variant_folder` and :func:`entry_dir`):
 
-- the **paper's setting** (the default): ``zoo/<MAP>/<variant>/seed<k>/``, one folder per
-  training seed, trained and evaluated with no return guard; ``zoo/<MAP>/<variant>/default.yml``
-  names the seed chosen by validation (``patrolsb3 zoo choose``, on the validation seed, never
-  the evaluation's). With a single seed and no ``default.yml``, that seed is the default.
-- **behind the return guard** (``guard=True``, strategy ``zoo:<variant>:guarded``):
+- the **main zoo** (no shelf): ``zoo/<MAP>/<variant>/seed<k>/``, one folder per training seed,
+  trained and evaluated in the paper's setting (no return guard) with the zoo's chosen recipe;
+  ``zoo/<MAP>/<variant>/default.yml`` names the seed chosen by validation (``patrolsb3 zoo
+  choose``, on the validation seed, never the evaluation's). With a single seed and no
+  ``default.yml``, that seed is the default.
+- a **recipe shelf** (``shelf="paper-recipe"``, strategy ``zoo:<variant>:paper-recipe``):
+  ``zoo/<shelf>/<MAP>/<variant>/seed<k>/``, the same layout as the main zoo's, for entries
+  trained with another recipe and compared beside the main ones.
+- **behind the return guard** (``shelf="guarded"``, strategy ``zoo:<variant>:guarded``):
   ``zoo/guarded/<MAP>/<variant>/``, the earlier entries that act with the heuristics' recharge
-  rule as a shield (``env.return_guard``, ours; not the paper's setting).
+  rule as a shield (``env.return_guard``, ours; not the paper's setting); this shelf keeps its
+  earlier layout: the variant folder is the entry (its default), with optional ``seed<k>``
+  subfolders.
 
 Each entry folder holds ``model.zip`` (policy only, no optimizer state), ``config.yml`` (env
 config, algorithm, hyperparameters, versions, training budget), ``command.txt``,
@@ -25,7 +32,7 @@ import yaml
 
 from .. import names
 from ..core.maps import parse_map
-from ..names import GUARDED, VARIANT_NAMES
+from ..names import GUARDED, SHELVES, VARIANT_NAMES, check_shelf
 from ..outputs import read_eval_file
 from ..runs import ZooEntry, read_config
 
@@ -91,7 +98,7 @@ DEFAULT_FILE = ZooEntry.DEFAULT
 """In a paper-setting entry folder: ``{seed: k, chosen_by: ...}``, the seed ``load`` uses by default."""
 
 
-def parse_strategy(name: str) -> tuple[str, bool]:
+def parse_strategy(name: str) -> tuple[str, str]:
     """:func:`patrolsb3.names.parse_strategy`, its error a :class:`ZooError`."""
     try:
         return names.parse_strategy(name)
@@ -99,66 +106,90 @@ def parse_strategy(name: str) -> tuple[str, bool]:
         raise ZooError(str(exc)) from None
 
 
-def variant_folder(map_name: str, variant: str, zoo_dir=None, guard: bool = False) -> Path:
-    """``<zoo>/<MAP>/<variant>`` (paper's setting) or ``<zoo>/guarded/<MAP>/<variant>``; it need not exist."""
+def variant_folder(map_name: str, variant: str, zoo_dir=None, shelf: str = "") -> Path:
+    """``<zoo>/<MAP>/<variant>`` (the main zoo) or ``<zoo>/<shelf>/<MAP>/<variant>``; it need not exist.
+
+    Raises:
+        ZooError: an unknown shelf.
+    """
     root = zoo_root(zoo_dir)
-    return (root / GUARDED if guard else root) / str(map_name).upper() / variant
+    return (root / checked_shelf(shelf) if shelf else root) / str(map_name).upper() / variant
 
 
-def seeds(map_name: str, variant: str, zoo_dir=None, guard: bool = False) -> list[int]:
+def checked_shelf(shelf: str) -> str:
+    """:func:`patrolsb3.names.check_shelf`, its error a :class:`ZooError`."""
+    try:
+        return check_shelf(shelf)
+    except names.StrategyNameError as exc:
+        raise ZooError(str(exc)) from None
+
+
+def shelf_of(folder) -> str:
+    """The shelf an entry folder sits on ("" for the main zoo), from its place in the layout:
+    ``.../<shelf>/<MAP>/<variant>[/seed<k>]``."""
+    parts = Path(folder).resolve().parts
+    found = [i for i, part in enumerate(parts) if part in VARIANT_NAMES]
+    if not found or found[-1] < 2:
+        return ""
+    above_map = parts[found[-1] - 2]
+    return above_map if above_map in SHELVES else ""
+
+
+def seeds(map_name: str, variant: str, zoo_dir=None, shelf: str = "") -> list[int]:
     """The training seeds an entry holds (its ``seed<k>`` subfolders with a model)."""
-    folder = variant_folder(map_name, variant, zoo_dir, guard)
+    folder = variant_folder(map_name, variant, zoo_dir, shelf)
     return sorted(int(p.parent.name[4:]) for p in folder.glob(f"seed*/{ZooEntry.MODEL}") if p.parent.name[4:].isdigit())
 
 
-def seed_curves(map_name: str, variant: str, zoo_dir=None, guard: bool = False) -> list[Path]:
-    """The curve.csv of every training seed of an entry (the paper's setting; a guarded entry's
-    one), in seed order; [] when there is none."""
-    if guard:
-        path = ZooEntry(entry_dir(map_name, variant, zoo_dir, guard=True)).curve_file
+def seed_curves(map_name: str, variant: str, zoo_dir=None, shelf: str = "") -> list[Path]:
+    """The curve.csv of every training seed of an entry (a guarded entry's one), in seed order;
+    [] when there is none."""
+    if shelf == GUARDED:
+        path = ZooEntry(entry_dir(map_name, variant, zoo_dir, shelf=GUARDED)).curve_file
         return [path] if path.is_file() else []
-    found = [ZooEntry(entry_dir(map_name, variant, zoo_dir, seed=k)).curve_file for k in seeds(map_name, variant, zoo_dir)]
+    found = [ZooEntry(entry_dir(map_name, variant, zoo_dir, seed=k, shelf=shelf)).curve_file
+             for k in seeds(map_name, variant, zoo_dir, shelf)]
     return [p for p in found if p.is_file()]
 
 
-def default_seed(map_name: str, variant: str, zoo_dir=None) -> dict | None:
-    """The paper-setting entry's default seed: ``{"seed": k, "chosen_by": text}`` from its
-    ``default.yml``, else its only seed; None when it has no seed.
+def default_seed(map_name: str, variant: str, zoo_dir=None, shelf: str = "") -> dict | None:
+    """The entry's default seed (the main zoo or a recipe shelf): ``{"seed": k, "chosen_by":
+    text}`` from its ``default.yml``, else its only seed; None when it has no seed.
 
     Raises:
         ZooError: several seeds and no ``default.yml`` (say how to choose), or a default.yml
             naming a seed the entry lacks.
     """
-    folder = variant_folder(map_name, variant, zoo_dir)
-    have = seeds(map_name, variant, zoo_dir)
+    folder = variant_folder(map_name, variant, zoo_dir, shelf)
+    have = seeds(map_name, variant, zoo_dir, shelf)
+    choose = f"patrolsb3 zoo choose {str(map_name).upper()} {variant}" + (f" --shelf {shelf}" if shelf else "")
     if (folder / DEFAULT_FILE).is_file():
         try:
             chosen = yaml.safe_load((folder / DEFAULT_FILE).read_text()) or {}
         except (yaml.YAMLError, UnicodeDecodeError) as exc:
             raise ZooError(f"{folder / DEFAULT_FILE}: not valid YAML, cut or damaged ({str(exc).splitlines()[0]}); "
-                           f"write it again with 'patrolsb3 zoo choose {map_name} {variant}'") from None
+                           f"write it again with '{choose}'") from None
         if not isinstance(chosen, dict):
             raise ZooError(f"{folder / DEFAULT_FILE}: expected a mapping with 'seed', got {type(chosen).__name__}; "
-                           f"write it again with 'patrolsb3 zoo choose {map_name} {variant}'")
+                           f"write it again with '{choose}'")
         if chosen.get("seed") not in have:
             raise ZooError(f"{folder / DEFAULT_FILE}: names seed {chosen.get('seed')!r}, the entry has {have}")
         return chosen
     if len(have) > 1:
-        raise ZooError(f"{folder}: seeds {have} and no {DEFAULT_FILE}; run 'patrolsb3 zoo choose "
-                       f"{str(map_name).upper()} {variant}' to pick one by validation")
+        raise ZooError(f"{folder}: seeds {have} and no {DEFAULT_FILE}; run '{choose}' to pick one by validation")
     return {"seed": have[0], "chosen_by": "the only seed"} if have else None
 
 
-def entry_dir(map_name: str, variant: str, zoo_dir=None, seed: int | None = None, guard: bool = False) -> Path:
+def entry_dir(map_name: str, variant: str, zoo_dir=None, seed: int | None = None, shelf: str = "") -> Path:
     """Folder of one zoo entry (it need not exist).
 
-    Paper's setting: ``<zoo>/<MAP>/<variant>/seed<k>``, ``seed`` or else the default seed
-    (:func:`default_seed`; the bare variant folder when there is none). Behind the guard:
-    ``<zoo>/guarded/<MAP>/<variant>``, or its ``seed<k>`` subfolder.
+    The main zoo or a recipe shelf: ``<zoo>[/<shelf>]/<MAP>/<variant>/seed<k>``, ``seed`` or else
+    the default seed (:func:`default_seed`; the bare variant folder when there is none). Behind
+    the guard: ``<zoo>/guarded/<MAP>/<variant>``, or its ``seed<k>`` subfolder.
     """
-    folder = variant_folder(map_name, variant, zoo_dir, guard)
-    if seed is None and not guard:
-        chosen = default_seed(map_name, variant, zoo_dir)
+    folder = variant_folder(map_name, variant, zoo_dir, shelf)
+    if seed is None and shelf != GUARDED:
+        chosen = default_seed(map_name, variant, zoo_dir, shelf)
         seed = chosen["seed"] if chosen else None
     return folder if seed is None else folder / f"seed{int(seed)}"
 
@@ -191,37 +222,41 @@ def read_entry(path: Path, damaged_eval_ok: bool = False) -> dict:
 
 
 def list_entries(zoo_dir=None) -> list[dict]:
-    """Every entry folder of the zoo, the paper's setting (every seed) first, then the guarded
-    ones; sorted by map, variant and seed. Each dict also has ``guard`` (bool) and ``seed``
-    (the folder's training seed, None for a guarded entry's default folder)."""
+    """Every entry folder of the zoo, the main zoo's (every seed) first, then each shelf's in the
+    order of :data:`~patrolsb3.names.SHELVES`; sorted by map, variant and seed. Each dict also has
+    ``shelf`` ("" for the main zoo) and ``seed`` (the folder's training seed, None for a guarded
+    entry's default folder)."""
     root = zoo_root(zoo_dir)
     found = []
     config = ZooEntry.CONFIG
-    for guard, pattern in ((False, f"[A-Z]*/*/seed*/{config}"),
-                           (True, f"{GUARDED}/*/*/{config}"), (True, f"{GUARDED}/*/*/seed*/{config}")):
+    patterns = [("", f"[A-Z]*/*/seed*/{config}")]
+    for shelf in SHELVES:
+        patterns += ([(shelf, f"{shelf}/*/*/{config}")] if shelf == GUARDED else []) + \
+            [(shelf, f"{shelf}/[A-Z]*/*/seed*/{config}")]
+    for shelf, pattern in patterns:
         for path in sorted(root.glob(pattern)):
             entry = read_entry(path.parent)
             name = path.parent.name
-            entry["guard"] = guard
+            entry["shelf"] = shelf
             entry["seed"] = int(name[4:]) if name.startswith("seed") and name[4:].isdigit() else None
             found.append(entry)
     return found
 
 
-def available(map_name: str, variant: str, zoo_dir=None, guard: bool = False) -> bool:
-    """True when the zoo has a model for (map, variant) in that setting (in the paper's setting:
-    at least one trained seed, whether or not a default has been chosen among several; ask
+def available(map_name: str, variant: str, zoo_dir=None, shelf: str = "") -> bool:
+    """True when the zoo has a model for (map, variant) on that shelf (the main zoo or a recipe
+    shelf: at least one trained seed, whether or not a default has been chosen among several; ask
     :func:`default_seed` for that); False also when there is no zoo."""
     try:
-        if not guard:
-            return bool(seeds(map_name, variant, zoo_dir))
-        return ZooEntry(entry_dir(map_name, variant, zoo_dir, guard=guard)).model_file.is_file()
+        if shelf != GUARDED:
+            return bool(seeds(map_name, variant, zoo_dir, shelf))
+        return ZooEntry(entry_dir(map_name, variant, zoo_dir, shelf=shelf)).model_file.is_file()
     except ZooError:
         return False
 
 
 def existing_entry_dir(map_name: str, variant: str, zoo_dir=None, seed: int | None = None,
-                       guard: bool = False) -> Path:
+                       shelf: str = "") -> Path:
     """:func:`entry_dir`, checked: the folder holds a model.
 
     Raises:
@@ -229,15 +264,15 @@ def existing_entry_dir(map_name: str, variant: str, zoo_dir=None, seed: int | No
     """
     if variant not in VARIANT_NAMES:
         raise ZooError(f"unknown variant {variant!r}; known: {', '.join(VARIANT_NAMES)}")
-    setting = "behind the return guard" if guard else "in the paper's setting"
-    folder = entry_dir(map_name, variant, zoo_dir, seed, guard)
+    setting = f"on the shelf {shelf!r}" if shelf else "in the main zoo"
+    folder = entry_dir(map_name, variant, zoo_dir, seed, shelf)
     model = ZooEntry(folder).model_file
     if seed is not None and not model.is_file():
         raise ZooError(f"no seed {seed} of {str(map_name).upper()}/{variant} {setting} (looked for "
-                       f"{model}); its seeds: {seeds(map_name, variant, zoo_dir, guard) or 'none'}")
+                       f"{model}); its seeds: {seeds(map_name, variant, zoo_dir, shelf) or 'none'}")
     if not model.is_file():
         have = sorted({f"{str(e['config'].get('map', '?')).upper()}/{e['config'].get('variant', '?')}"
-                       + (f":{GUARDED}" if e["guard"] else "") for e in list_entries(zoo_dir)})
+                       + (f":{e['shelf']}" if e["shelf"] else "") for e in list_entries(zoo_dir)})
         raise ZooError(f"no zoo model for map {str(map_name).upper()} variant {variant} {setting} "
                        f"(looked for {model}); the zoo has: {', '.join(have) or 'nothing'}")
     return folder

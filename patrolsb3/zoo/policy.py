@@ -15,6 +15,7 @@ import numpy as np
 from ..core import protocol
 from ..core.config import ENV_VERSION, EnvConfig, make_config
 from ..core.maps import MapSpec, load_map
+from ..names import GUARDED
 from ..runs import RunFolder, ZooEntry, zip_is_intact
 from .folders import ZooError, existing_entry_dir, read_entry, training_map
 
@@ -232,7 +233,7 @@ def load_checkpoint(path, spec=None) -> ZooPolicy:
 
 
 def load(map_name: str, variant: str, zoo_dir=None, spec=None, device: str = "cpu",
-         seed: int | None = None, guard: bool = False) -> ZooPolicy:
+         seed: int | None = None, shelf: str = "", guard: bool = False) -> ZooPolicy:
     """Load a zoo model ready to act: ``patrolsb3.zoo.load("A", "rl-msg")``.
 
     Args:
@@ -243,15 +244,20 @@ def load(map_name: str, variant: str, zoo_dir=None, spec=None, device: str = "cp
         device: where the network runs: "cpu" (default), "cuda" or "auto".
         seed: one training seed's model (``seed<k>``); None: the entry's default, the seed
             chosen by validation (:func:`default_seed`).
-        guard: the entry trained and acting behind the return guard (``zoo/guarded/``, not the
-            paper's setting) instead of the paper's setting.
+        shelf: a shelf of the zoo instead of the main zoo (:data:`patrolsb3.names.SHELVES`):
+            ``"paper-recipe"``, ``"cd10"``, or ``"guarded"`` (the entry trained and acting behind
+            the return guard, ``zoo/guarded/``, not the paper's setting).
+        guard: ``shelf="guarded"``, said the way earlier releases did.
 
     Raises:
         ZooError: no such entry or seed (lists what the zoo has), or a checkpoint trained for
             another env version or map size.
         ValueError: a device torch cannot use.
     """
-    folder = existing_entry_dir(map_name, variant, zoo_dir, seed, guard)
+    if guard and shelf not in ("", GUARDED):
+        raise ZooError(f"guard=True and shelf={shelf!r}: the entries behind the return guard are the shelf "
+                       f"{GUARDED!r}; give one of the two")
+    folder = existing_entry_dir(map_name, variant, zoo_dir, seed, GUARDED if guard else shelf)
     return load_entry(folder, spec=spec if spec is not None else map_name, device=device)
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.streams import STREAMS_VERSION
-from ..names import strategy_name
+from ..names import GUARDED, strategy_name
 from ..outputs import read_eval_file
 from ..runs import ZooEntry
 from ..stats import RATE_METRICS, rate_interval, seed_interval
@@ -14,11 +14,11 @@ from .folders import entry_dir, read_entry, seeds
 
 
 def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, steps: int, seed: int,
-                  tests: int = 1, zoo_dir=None, deterministic: bool = True, guard: bool = False,
+                  tests: int = 1, zoo_dir=None, deterministic: bool = True, shelf: str = "",
                   training_seed: int | None = None):
     """One entry's eval.json result for exactly this protocol and action mode, or None: the
-    default seed's, or ``training_seed``'s."""
-    path = ZooEntry(entry_dir(map_name, variant, zoo_dir, seed=training_seed, guard=guard)).evaluation_file
+    default seed's, or ``training_seed``'s (of the main zoo, or of ``shelf``)."""
+    path = ZooEntry(entry_dir(map_name, variant, zoo_dir, seed=training_seed, shelf=shelf)).evaluation_file
     if not path.is_file():
         return None
     data = read_eval_file(path)
@@ -27,12 +27,13 @@ def cached_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
                                                                      STREAMS_VERSION):
         return None
     found = next((r for r in data.get("results", []) if r["n_agents"] == n_agents), None)
-    return None if found is None else {**found, "strategy": strategy_name(variant, guard)}
+    return None if found is None else {**found, "strategy": strategy_name(variant, shelf)}
 
 
 def pooled_result(map_name: str, variant: str, n_agents: int, episodes: int, steps: int, seed: int,
-                  tests: int = 1, zoo_dir=None, deterministic: bool = True):
-    """The paper-setting entry's figures pooled over its training seeds, from their eval.json.
+                  tests: int = 1, zoo_dir=None, deterministic: bool = True, shelf: str = ""):
+    """The entry's figures pooled over its training seeds, from their eval.json (the main zoo, or
+    a recipe ``shelf``).
 
     Every seed whose eval.json holds this protocol and per-episode figures contributes. The
     training seed is the unit: a mean metric's figure is the mean of the seeds' means and its 95 %
@@ -51,9 +52,9 @@ def pooled_result(map_name: str, variant: str, n_agents: int, episodes: int, ste
         before per-episode figures were stored), or None when no seed has such a result.
     """
     usable, left_out = [], []
-    for k in seeds(map_name, variant, zoo_dir):
+    for k in seeds(map_name, variant, zoo_dir, shelf):
         r = cached_result(map_name, variant, n_agents, episodes, steps, seed, tests, zoo_dir,
-                          deterministic, training_seed=k)
+                          deterministic, shelf=shelf, training_seed=k)
         if r is not None and all("episodes" in v for v in r["summary"].values() if isinstance(v, dict) and "ci95" in v):
             usable.append((k, r))
         else:
@@ -102,15 +103,15 @@ def recipe_of(config: dict) -> str:
     return f"{config.get('recipe') or 'recipe not recorded'} (c_d {c_d:g}, gamma {hp.get('gamma', '?')}, {length})"
 
 
-def trained_with(map_name: str, variant: str, zoo_dir=None, guard: bool = False) -> str:
+def trained_with(map_name: str, variant: str, zoo_dir=None, shelf: str = "") -> str:
     """How the entries of a zoo column were trained: each distinct :func:`recipe_of` with the
     training seeds that have it, e.g. ``zoo-stage2 (c_d 200, gamma 0.99, 1,500-step episodes):
     seeds 0, 1, 2``. The entry behind the guard has one folder and no seeds."""
-    if guard:
-        return recipe_of(read_entry(entry_dir(map_name, variant, zoo_dir, guard=True))["config"])
+    if shelf == GUARDED:
+        return recipe_of(read_entry(entry_dir(map_name, variant, zoo_dir, shelf=GUARDED))["config"])
     by_recipe: dict[str, list[int]] = {}
-    for seed in seeds(map_name, variant, zoo_dir):
-        config = read_entry(entry_dir(map_name, variant, zoo_dir, seed=seed))["config"]
+    for seed in seeds(map_name, variant, zoo_dir, shelf):
+        config = read_entry(entry_dir(map_name, variant, zoo_dir, seed=seed, shelf=shelf))["config"]
         by_recipe.setdefault(recipe_of(config), []).append(seed)
     return "; ".join(f"{phrase}: seed{'s' if len(found) > 1 else ''} {', '.join(map(str, found))}"
                      for phrase, found in by_recipe.items())

@@ -16,6 +16,7 @@ import numpy as np
 import yaml
 
 from ..evaluate import run_episodes, team_batch
+from ..names import GUARDED
 from ..runs import RunFolder, is_valid_model_file, model_steps, write_atomically
 from .folders import DEFAULT_FILE, ZooError, seeds, variant_folder
 from .policy import evaluation_config, load_checkpoint, load_entry
@@ -83,8 +84,9 @@ def rank(rows: list[dict]) -> list[dict]:
 
 
 def choose_default(map_name: str, variant: str, zoo_dir=None, team_sizes=(1, 3, 5), episodes: int = 4,
-                   steps: int = 3000, seed: int = 7) -> dict:
-    """Pick the paper-setting entry's default seed by validation and write its ``default.yml``.
+                   steps: int = 3000, seed: int = 7, shelf: str = "") -> dict:
+    """Pick the entry's default seed (the main zoo's, or a recipe ``shelf``'s) by validation and
+    write its ``default.yml``.
 
     Each seed's model plays the greedy validation protocol of ``zoo validate`` (its own
     simulator seed, not the evaluation's 0, so the choice does not peek at the reported
@@ -95,10 +97,14 @@ def choose_default(map_name: str, variant: str, zoo_dir=None, team_sizes=(1, 3, 
         What was written: {"seed", "chosen_by", "validation": [one row per seed]}.
 
     Raises:
-        ZooError: the entry has no seed.
+        ZooError: the entry has no seed, or the shelf is "guarded" (one entry folder, no default
+            to choose).
     """
-    folder = variant_folder(map_name, variant, zoo_dir)
-    have = seeds(map_name, variant, zoo_dir)
+    if shelf == GUARDED:
+        raise ZooError(f"--shelf {GUARDED}: the entries behind the return guard have one default folder each; "
+                       f"there is no seed to choose")
+    folder = variant_folder(map_name, variant, zoo_dir, shelf)
+    have = seeds(map_name, variant, zoo_dir, shelf)
     if not have:
         raise ZooError(f"{folder}: no seed<k>/model.zip to choose from")
     rows = [{"seed": k, **validate_policy(load_entry(folder / f"seed{k}"), team_sizes, episodes, steps, seed)}
