@@ -91,7 +91,8 @@ def sweep_on_ray(trials, run_trial: Callable, cpus_per_trial: int = 1, storage: 
         say: receives one line per finished or failed trial, with its wall time.
 
     Returns:
-        {trial name: {"status": "finished" | "error", "seconds": s, "error": one line}}.
+        {trial name: :func:`trial_outcome`'s ``{"status": "finished" | "error" | "stopped", "seconds": s,
+        "error": one line}``}.
     """
     require_ray()
     from ray import tune
@@ -133,14 +134,39 @@ def sweep_on_ray(trials, run_trial: Callable, cpus_per_trial: int = 1, storage: 
         if not result.config:            # a trial whose record Ray could not read back: stays an error
             continue
         trial = by_index[result.config["trial"]]
-        metrics = result.metrics or {}
-        error = _cause(result.error) if result.error else ""
-        reached = int(metrics.get("timesteps", 0))
-        if not error and reached < trial.timesteps:
-            error = f"the trial ended at {reached:,} of its {trial.timesteps:,} agent-steps"
-        outcome[trial.name] = {"status": "error" if error else "finished",
-                               "seconds": float(metrics.get("seconds", 0.0)), "error": error}
+        outcome[trial.name] = trial_outcome(result.metrics or {}, _cause(result.error) if result.error else "",
+                                            trial.timesteps)
     return outcome
+
+
+STOPPED = ("stopped before its end without an error (the sweep was interrupted: Ctrl-C, SIGINT or a time "
+           "limit); run the sweep again to continue from its newest checkpoint")
+"""What the summary says of a trial that Tune stopped: it reported nothing and raised nothing."""
+
+
+def trial_outcome(metrics: dict, error: str, timesteps: int) -> dict:
+    """How one trial ended, from what Tune returned for it.
+
+    Args:
+        metrics: the trial's last report (``{"timesteps", "seconds"}``; {} when it reported nothing).
+        error: the one-line cause of its exception ("" without one).
+        timesteps: the agent-steps it was asked for.
+
+    Returns:
+        ``{"status", "seconds", "error"}``: ``finished`` (it reported its whole budget), ``error``
+        (an exception, or a report short of the budget), or ``stopped`` (no report and no
+        exception: the sweep was interrupted; the run folder resumes from its newest checkpoint).
+    """
+    seconds = float(metrics.get("seconds", 0.0))
+    if error:
+        return {"status": "error", "seconds": seconds, "error": error}
+    if "timesteps" not in metrics:
+        return {"status": "stopped", "seconds": seconds, "error": STOPPED}
+    reached = int(metrics["timesteps"])
+    if reached < timesteps:
+        return {"status": "error", "seconds": seconds,
+                "error": f"the trial ended at {reached:,} of its {timesteps:,} agent-steps"}
+    return {"status": "finished", "seconds": seconds, "error": ""}
 
 
 def evaluate_on_ray(jobs: list[dict]) -> Iterator[tuple[int, dict, float]]:

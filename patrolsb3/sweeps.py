@@ -78,7 +78,8 @@ class Trial:
 
 @dataclass
 class TrialOutcome:
-    """How a trial ended: ``status`` is finished, skipped (finished before), error or pending."""
+    """How a trial ended: ``status`` is finished, skipped (finished before), error, stopped (the
+    sweep was interrupted; it resumes from its newest checkpoint) or pending."""
     trial: Trial
     status: str
     seconds: float = 0.0

@@ -138,3 +138,13 @@ def test_a_trial_records_its_sweeps_recipe_in_the_run_config(tmp_path):
                   run_dir=tmp_path / "A" / "rl-no-msg" / "seed0", recipe="paper")
     assert run_trial(trial)["timesteps"] >= 320
     assert yaml.safe_load((trial.run_dir / "config.yml").read_text())["recipe"] == "paper"
+
+
+def test_a_trial_stopped_by_an_interrupted_sweep_says_so_and_how_to_go_on():
+    from patrolsb3.distributed import trial_outcome
+    assert trial_outcome({}, "", 1600)["status"] == "stopped"              # Tune stopped it: no report, no error
+    assert "run the sweep again to continue from its newest checkpoint" in trial_outcome({}, "", 1600)["error"]
+    assert trial_outcome({"timesteps": 1600, "seconds": 3.0}, "", 1600) == {"status": "finished", "seconds": 3.0,
+                                                                             "error": ""}
+    assert trial_outcome({"timesteps": 800}, "", 1600)["error"] == "the trial ended at 800 of its 1,600 agent-steps"
+    assert trial_outcome({}, "ValueError: bad", 1600) == {"status": "error", "seconds": 0.0, "error": "ValueError: bad"}

@@ -26,4 +26,6 @@ def run(args):
     outcomes = run_sweep(args.sweep_file, out=args.out, precision=args.precision, address=args.address, cpus=args.cpus,
                          cpus_per_trial=args.cpus_per_trial, dry_run=args.dry_run, say=partial(print, flush=True))
     print(summary_table(outcomes))
-    return 1 if any(o.status == "error" for o in outcomes) else 0
+    if any(o.status == "error" for o in outcomes):
+        return 1
+    return 130 if any(o.status == "stopped" for o in outcomes) else 0     # 130: stopped by a signal
