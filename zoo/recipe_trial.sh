@@ -1,0 +1,115 @@
+#!/usr/bin/env bash
+# Issue 43's recipe trial on map A (rl-msg, three training seeds a recipe), once its runs have
+# finished, in the order the rule (docs/experiments/2026-12-07-afternoon.md, written before any
+# result) demands. Run from the repository root, one step at a time:
+#
+#   zoo/recipe_trial.sh choose    # validate E1's and E2's runs (seed 7), apply the rule: RULE_JSON
+#   zoo/recipe_trial.sh shelve    # only after 'choose': E1 onto zoo/cd10/, E2 onto zoo/paper-recipe/,
+#                                 #   each with its 24 h eval.json (seed 0), listening and ablation
+#   zoo/recipe_trial.sh budget    # E2's checkpoints at 16 M and 32 M agent-steps (1.6 M and 3.2 M
+#                                 #   episode steps), evaluated like an entry, in a scratch zoo
+#   zoo/recipe_trial.sh compare   # E0, E1, E2 beside CR, PART, SEBS on A, and the claims of each
+#
+# E1: runs/e1/stage2/A/rl-msg/seed<k> (zoo/train_paper_setting.sh with env.c_d=10); E2:
+# runs/e2/A/rl-msg/seed<k> (patrolsb3 sweep zoo/sweeps/paper-recipe-a.yml); E0: the zoo's
+# A/rl-msg seeds. RULE_JSON (default zoo/comparison-recipes/recipe_rule.json) keeps every
+# model's rule figures; it starts from E0's (2026-12-07-night-logs/recipe_rule_E0.json), so E0 is
+# not played again. Logs go to runs/recipe_trial/.
+set -euo pipefail
+STEP=${1:?usage: zoo/recipe_trial.sh choose|shelve|budget|compare}
+SEEDS=(0 1 2)
+E1_RUNS=runs/e1/stage2/A/rl-msg
+E2_RUNS=runs/e2/A/rl-msg
+LOG=runs/recipe_trial
+RULE_JSON=${RULE_JSON:-zoo/comparison-recipes/recipe_rule.json}
+mkdir -p "$LOG"
+
+finished() {   # every seed of a recipe has its model.zip
+  local runs=$1 k
+  for k in "${SEEDS[@]}"; do
+    if [ ! -f "$runs/seed$k/model.zip" ]; then
+      echo "recipe_trial.sh: $runs/seed$k has not finished (no model.zip); continue it first (zoo/in_progress/README.md)" >&2
+      exit 2
+    fi
+  done
+}
+
+best_of() {    # the checkpoint 'zoo validate --last 6' chose for one run (validated once)
+  local run=$1 tag=$2
+  if [ ! -s "$LOG/validate_$tag.txt" ]; then
+    patrolsb3 zoo validate "$run" --last 6 > "$LOG/validate_$tag.txt" 2>&1
+  fi
+  sed -n 's/^best: //p' "$LOG/validate_$tag.txt"
+}
+
+chosen() {     # the recipe the rule chose, from RULE_JSON; empty before 'choose'
+  [ -f "$RULE_JSON" ] && python -c "import json, sys; print(json.load(open(sys.argv[1])).get('chosen', ''))" "$RULE_JSON"
+}
+
+case "$STEP" in
+  choose)
+    finished "$E1_RUNS"; finished "$E2_RUNS"
+    e0=$(IFS=,; echo "${SEEDS[*]/#/zoo/A/rl-msg/seed}")
+    e1=(); e2=()
+    for k in "${SEEDS[@]}"; do
+      e1+=("$(best_of "$E1_RUNS/seed$k" "e1_seed$k")")
+      e2+=("$(best_of "$E2_RUNS/seed$k" "e2_seed$k")")
+    done
+    mkdir -p "$(dirname "$RULE_JSON")"
+    [ -f "$RULE_JSON" ] || cp docs/experiments/2026-12-07-night-logs/recipe_rule_E0.json "$RULE_JSON"
+    python docs/experiments/2026-12-07-evening-scripts/recipe_rule.py "E0=$e0" \
+      "E1=$(IFS=,; echo "${e1[*]}")" "E2=$(IFS=,; echo "${e2[*]}")" --json "$RULE_JSON" | tee "$LOG/rule.txt"
+    ;;
+  shelve)
+    if [ -z "$(chosen)" ]; then
+      echo "recipe_trial.sh: no choice in $RULE_JSON yet; run 'zoo/recipe_trial.sh choose' first (no seed-0 evaluation before the rule)" >&2
+      exit 2
+    fi
+    for k in "${SEEDS[@]}"; do
+      OUT=$LOG RUN="$E1_RUNS/seed$k" SHELF=cd10 CHECKPOINT="$(best_of "$E1_RUNS/seed$k" "e1_seed$k")" \
+        zoo/finish_paper_run.sh A rl-msg "$k"
+      OUT=$LOG RUN="$E2_RUNS/seed$k" SHELF=paper-recipe CHECKPOINT="$(best_of "$E2_RUNS/seed$k" "e2_seed$k")" \
+        zoo/finish_paper_run.sh A rl-msg "$k"
+    done
+    patrolsb3 zoo choose A rl-msg --shelf cd10
+    patrolsb3 zoo choose A rl-msg --shelf paper-recipe
+    ;;
+  budget)
+    finished "$E2_RUNS"
+    if [ -z "$(chosen)" ]; then
+      echo "recipe_trial.sh: no choice in $RULE_JSON yet; run 'zoo/recipe_trial.sh choose' first (no seed-0 evaluation before the rule)" >&2
+      exit 2
+    fi
+    for steps in 16000000 32000000; do
+      for k in "${SEEDS[@]}"; do
+        checkpoint="$E2_RUNS/seed$k/checkpoints/model_${steps}_steps.zip"
+        if [ ! -f "$checkpoint" ]; then
+          echo "recipe_trial.sh: $checkpoint is missing (snapshots keep it as a milestone)" >&2
+          exit 2
+        fi
+        patrolsb3 zoo export "$E2_RUNS/seed$k" --checkpoint "$checkpoint" --shelf paper-recipe \
+          --zoo-dir "$LOG/budget-$steps" > "$LOG/budget_${steps}_seed$k.txt" 2>&1
+      done
+      echo "E2 at $steps agent-steps: $LOG/budget-$steps/paper-recipe/A/rl-msg/seed*/eval.json"
+    done
+    ;;
+  compare)
+    if [ -z "$(chosen)" ]; then
+      echo "recipe_trial.sh: no choice in $RULE_JSON yet; run 'zoo/recipe_trial.sh choose' first" >&2
+      exit 2
+    fi
+    patrolsb3 compare --maps A --agents 1-5 --episodes 10 --steps 14400 --out zoo/comparison-recipes \
+      --strategies CR,PART,SEBS,zoo:rl-msg,zoo:rl-msg:cd10,zoo:rl-msg:paper-recipe --no-progress \
+      > "$LOG/compare.txt" 2>&1
+    patrolsb3 claims zoo/comparison-recipes --json zoo/comparison-recipes/claims.json > zoo/comparison-recipes/claims.md
+    for shelf in cd10 paper-recipe; do
+      patrolsb3 claims zoo/comparison-recipes --shelf "$shelf" --json "zoo/comparison-recipes/claims-$shelf.json" \
+        > "zoo/comparison-recipes/claims-$shelf.md"
+    done
+    echo "zoo/comparison-recipes: report.md, claims.md (E0), claims-cd10.md (E1), claims-paper-recipe.md (E2)"
+    ;;
+  *)
+    echo "usage: zoo/recipe_trial.sh choose|shelve|budget|compare" >&2
+    exit 2
+    ;;
+esac
