@@ -366,6 +366,14 @@ def test_an_entry_on_a_recipe_shelf_is_its_own_column_beside_the_main_zoo(traine
     assert "--guarded and --shelf cd10" in capsys.readouterr().err
 
 
+def test_a_card_says_the_precision_of_each_stretch_of_training():
+    from patrolsb3.zoo.cards import precision_text
+    assert precision_text({"hyperparams": {}}) == "fp32"
+    changed = {"hyperparams": {"precision": "bf16"},
+               "precision_changes": [{"timesteps": 8800000, "precision": "fp32", "why": "no native bf16"}]}
+    assert precision_text(changed) == "bf16 to 8,800,000 agent-steps, then fp32"
+
+
 def test_claims_on_a_shelf_put_its_columns_in_place_of_the_main_zoos():
     from patrolsb3.commands.claims import on_shelf
     from patrolsb3.report import column_strategy

@@ -126,6 +126,15 @@ def messages_page(entries: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def precision_text(config: dict) -> str:
+    """The precision a run trained in, with each change on a resume: ``fp32``, or ``bf16 to
+    8,800,000 agent-steps, then fp32``. Runs from before the setting are fp32."""
+    text = str((config.get("hyperparams") or {}).get("precision", "fp32"))
+    for change in config.get("precision_changes") or []:
+        text += f" to {int(change['timesteps']):,} agent-steps, then {change['precision']}"
+    return text
+
+
 def card(entry: dict) -> str:
     """The markdown card of one entry (``patrolsb3.zoo.list_entries``' dict)."""
     c, ev = entry["config"], entry.get("eval") or {}
@@ -140,6 +149,7 @@ def card(entry: dict) -> str:
                                    "recharge rule as a shield on the moves; not the paper's setting)"
                                    if guarded else "the paper's setting (no return guard)"),
              f"- **recipe**: {recipe_of(c)}; docs/training.md compares the recipes",
+             f"- **precision**: {precision_text(c)}",
              f"- **observation**: messages `{env.get('message_encoding', 'scalar')}`, local idleness "
              f"{'on' if env.get('local_idleness') else 'off'}, difference-reward weight c_d = {env.get('c_d')}",
              f"- **budget**: {int(budget.get('timesteps', 0)):,} agent-steps (all stages), about "
