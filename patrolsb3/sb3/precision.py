@@ -77,7 +77,7 @@ def resumed_precision(recorded: str, asked: str, device: str = "cpu") -> tuple[s
     not native (a CPU without ``avx512_bf16`` / ``amx_bf16`` / Arm ``bf16``) goes on in fp32
     unless ``bf16`` is asked for explicitly. Emulated bf16 is several times slower than fp32 (on
     an AMD EPYC without AVX512-BF16, one rollout and update of issue 43's E2 took more than 415
-    CPU seconds in emulated bf16, against 160-166 in fp32), and bf16 and fp32 learn alike
+    CPU seconds in emulated bf16, against 160-200 in fp32), and bf16 and fp32 learn alike
     (docs/training.md, "Precision").
 
     Args:
