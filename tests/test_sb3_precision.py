@@ -144,7 +144,9 @@ def test_a_bf16_run_resumed_without_native_bf16_goes_on_in_fp32_and_says_from_wh
     train(map=ROOM, timesteps=1200, out=tmp_path, hyperparams=tiny_hp(precision="auto"), resume=True, progress_bar=False)
     assert "goes on in" not in capsys.readouterr().err
     assert len(RunFolder(run).read_config()["precision_changes"]) == 1
-    # bf16 asked for explicitly keeps bf16, emulated or not
+    # bf16 asked for explicitly keeps bf16, emulated or not, and says what that costs
+    train(map=ROOM, timesteps=400, out=tmp_path / "explicit", hyperparams=tiny_hp(precision="bf16"), progress_bar=False)
+    assert "this CPU has no native bf16, so torch emulates it" in capsys.readouterr().err
     assert precision_module.resumed_precision("bf16", "bf16") == ("bf16", "")
     assert precision_module.resumed_precision("fp32", "auto") == ("fp32", "")
     # a resume from a checkpoint before the change drops it (the stretch after it is gone)

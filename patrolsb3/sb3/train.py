@@ -30,7 +30,7 @@ from .cpu_time import CpuTimeCallback, cpu_hours_of, read_rows, restart_at
 from .curriculum import CURRICULUM, CurriculumCallback
 from .hyperparams import load_hyperparams, merge, per_phase, schedule
 from .policy import policy_kwargs_for
-from .precision import PRECISIONS, resolve_precision, resumed_precision
+from .precision import PRECISIONS, cpu_info, resolve_precision, resumed_precision
 from .variants import variant_overrides
 from .vec_env import DEFAULT_AGENTS, make_vec_env, training_config
 
@@ -339,7 +339,7 @@ def run_precision(hp: dict, device_type: str, resumed: RunFolder | None = None,
     asked = hp.get("precision", "auto")
     wanted = resolve_precision(asked, device_type)
     if resumed is None or not resumed.config_file.is_file():
-        return wanted, ""
+        return warned_if_emulated(wanted, device_type), ""
     recorded = resumed.read_config()
     kept = (recorded.get("hyperparams") or {}).get("precision", "fp32")
     for change in recorded.get("precision_changes") or []:       # the latest change before the checkpoint
@@ -352,7 +352,16 @@ def run_precision(hp: dict, device_type: str, resumed: RunFolder | None = None,
     elif used != wanted:
         print(f"--resume: {resumed.path} keeps the precision it was trained with ({used}), not {wanted}",
               file=sys.stderr)
-    return used, why
+    return warned_if_emulated(used, device_type), why
+
+
+def warned_if_emulated(precision: str, device_type: str) -> str:
+    """``precision``, after a note on stderr when it is bf16 on a CPU without native bf16 (asked
+    for explicitly: torch emulates it, several times slower than fp32)."""
+    if precision == "bf16" and str(device_type).startswith("cpu") and not cpu_info()["native_bf16"]:
+        print("precision bf16: this CPU has no native bf16, so torch emulates it, several times slower "
+              "than fp32 (precision auto picks fp32 here)", file=sys.stderr)
+    return precision
 
 
 def mixed_episodes(hp: dict, n_episodes: int) -> dict:
