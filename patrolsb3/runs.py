@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import re
 import shutil
 import zipfile
@@ -88,14 +89,43 @@ def read_config(path: Path) -> dict:
 
 
 def recorded_path(path) -> str:
-    """How a record (config.yml, a command's output) names a file: relative to the working
-    directory when it lies under it (a run started from the repository root names its source as
-    ``runs/...``, no path of this machine), else resolved and absolute."""
+    """How a record (config.yml, a command's output, a checkpoint's TensorBoard folder) names a
+    file: relative to the working directory when it lies under it (a run started from the
+    repository root names its source as ``runs/...``, no path of this machine), else resolved
+    and absolute. "Under it" is judged before symbolic links are followed, then after: a
+    worktree whose ``runs/`` links to another checkout's still records ``runs/...``."""
     path = Path(path)
-    try:
-        return str(path.resolve().relative_to(Path.cwd().resolve()))
-    except ValueError:
-        return str(path.resolve())
+    cwd = Path.cwd()
+    for candidate, base in ((Path(os.path.abspath(path)), Path(os.path.abspath(cwd))), (path.resolve(), cwd.resolve())):
+        try:
+            return str(candidate.relative_to(base))
+        except ValueError:
+            continue
+    return str(path.resolve())
+
+
+def relative_tensorboard_log(model_zip, folder: str) -> None:
+    """Write ``folder`` as the TensorBoard folder an SB3 checkpoint records (its ``data``
+    member's ``tensorboard_log``), where it records an absolute path; every other member stays
+    byte for byte. A resume sets the folder anew (``train``), so this only keeps the path of the
+    machine that wrote it out of a copy that travels (:meth:`RunFolder.snapshot`)."""
+    path = Path(model_zip)
+    with zipfile.ZipFile(path) as source:
+        members = [(info, source.read(info)) for info in source.infolist()]
+    changed = False
+    for i, (info, payload) in enumerate(members):
+        if info.filename == "data":
+            data = json.loads(payload)
+            if isinstance(data.get("tensorboard_log"), str) and os.path.isabs(data["tensorboard_log"]):
+                data["tensorboard_log"] = str(folder)
+                members[i] = (info, json.dumps(data, indent=4).encode())
+                changed = True
+    if changed:
+        def write(partial: Path) -> None:
+            with zipfile.ZipFile(partial, "w") as out:
+                for info, payload in members:
+                    out.writestr(info, payload)
+        write_atomically(path, write)
 
 
 def zip_is_intact(path) -> bool:
@@ -401,6 +431,8 @@ class RunFolder:
         target.create()
         for source in sources:
             shutil.copy2(source, target.checkpoints_dir / source.name)
+            if source.suffix == ".zip":      # no path of this machine travels inside a checkpoint
+                relative_tensorboard_log(target.checkpoints_dir / source.name, recorded_path(self.tensorboard_dir))
         for name in (self.CONFIG, self.COMMAND) + self.RECORDS:
             if (self.path / name).is_file():
                 shutil.copy2(self.path / name, target.path / name)

@@ -195,3 +195,29 @@ def test_recorded_path_is_relative_under_the_working_folder_and_absolute_outside
     assert recorded_path(inside) == "runs/x/model.zip"
     assert recorded_path("runs/x") == "runs/x"
     assert recorded_path(tmp_path / "elsewhere") == str((tmp_path / "elsewhere").resolve())
+
+
+def test_a_worktree_whose_runs_folder_links_elsewhere_still_records_runs_relative(tmp_path, monkeypatch):
+    from patrolsb3.runs import recorded_path
+    (tmp_path / "main" / "runs" / "e2").mkdir(parents=True)
+    (tmp_path / "worktree").mkdir()
+    (tmp_path / "worktree" / "runs").symlink_to(tmp_path / "main" / "runs")      # runs/ shared with the checkout
+    monkeypatch.chdir(tmp_path / "worktree")
+    assert recorded_path("runs/e2/tb") == "runs/e2/tb"
+    assert recorded_path(tmp_path / "worktree" / "runs" / "e2") == "runs/e2"
+
+
+def test_a_snapshot_carries_no_absolute_tensorboard_folder_inside_its_checkpoint(tmp_path, monkeypatch):
+    import json
+    import zipfile
+    monkeypatch.chdir(tmp_path)
+    run = _stopped_run(tmp_path / "runs" / "e2", steps=(400,))
+    with zipfile.ZipFile(run.checkpoint_file(400), "w") as archive:      # what SB3 writes, and a weight file
+        archive.writestr("data", json.dumps({"tensorboard_log": str(tmp_path / "runs" / "e2" / "tb"), "gamma": 0.95}))
+        archive.writestr("policy.pth", b"\x00\x01weights")
+    copied = run.snapshot(tmp_path / "snap")
+    with zipfile.ZipFile(copied) as archive:
+        assert json.loads(archive.read("data")) == {"tensorboard_log": "runs/e2/tb", "gamma": 0.95}
+        assert archive.read("policy.pth") == b"\x00\x01weights"
+    with zipfile.ZipFile(run.checkpoint_file(400)) as archive:           # the run's own file is left as it was
+        assert json.loads(archive.read("data"))["tensorboard_log"].startswith(str(tmp_path))
