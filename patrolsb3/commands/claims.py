@@ -23,16 +23,16 @@ def on_shelf(figures: dict, shelf: str) -> dict:
     """The figures the claims test: with a ``shelf``, its columns (``zoo:<variant>:<shelf>``) stand
     in for the learned variants, and a main-zoo column is kept only for a variant the shelf lacks;
     columns of other shelves are left out either way."""
-    def shelf_of(name):
-        return zoo.parse_strategy(name)[1] if is_learned(name) else ""
+    names = {name for _, _, name, _ in figures}
+    shelf_of = {name: zoo.parse_strategy(name)[1] for name in names if is_learned(name)}     # parsed once
     suffix = f":{shelf}"
     kept = {}
     for (m, n, name, metric), figure in figures.items():
-        if not is_learned(name):
+        if name not in shelf_of:
             kept[(m, n, name, metric)] = figure
-        elif shelf and shelf_of(name) == shelf:
+        elif shelf and shelf_of[name] == shelf:
             kept[(m, n, name.removesuffix(suffix), metric)] = figure
-        elif shelf_of(name) == "" and not (shelf and any(k[2] == name + suffix for k in figures)):
+        elif shelf_of[name] == "" and not (shelf and name + suffix in names):
             kept.setdefault((m, n, name, metric), figure)
     return kept
 
