@@ -377,7 +377,7 @@ class RunFolder:
         """``model.zip`` when the run finished, else its newest valid checkpoint, else None."""
         return self.model_file if self.model_file.is_file() else self.newest_checkpoint()
 
-    def snapshot(self, dest, keep: int = 1, milestones=()) -> Path:
+    def snapshot(self, dest, keep: int = 1, milestones=(), chosen=None) -> Path:
         """Copy what ``--resume`` needs into a new run folder ``dest``: the newest valid checkpoint
         (the model with its optimizer state) and its reward statistics, config.yml, command.txt
         and the CSV records; TensorBoard logs and, unless ``keep`` asks for them, older
@@ -392,28 +392,41 @@ class RunFolder:
                 sees those written before the stop.
             milestones: agent-steps whose checkpoints are kept too, where the run has them (a run
                 evaluated along the way, e.g. issue 43's E2 at the zoo's budget of 16 M and at 32 M).
+            chosen: the checkpoint that validation chose (``zoo validate RUN --last 6``), a file of
+                this run. Needed to snapshot a *finished* run: the snapshot then keeps ``model.zip``,
+                the chosen checkpoint and the milestones (not the newest ``keep``), which is all
+                that exporting the run later reads (issue 43's E1 finishes sessions before E2, and
+                nothing is exported before the rule has chosen). For a stopped run it is kept
+                beside the newest ones.
 
         Returns:
-            The newest checkpoint copied, in ``dest``.
+            The newest checkpoint copied, in ``dest`` (``model.zip`` for a finished run whose
+            final model was chosen and which keeps no milestone).
 
         Raises:
-            ValueError: ``keep`` is below 1.
+            ValueError: ``keep`` is below 1, or ``chosen`` is not a valid checkpoint of this run.
             FileNotFoundError: no valid checkpoint, or the statistics file of one to copy is
                 missing in a run that normalises its rewards (names it).
-            FileExistsError: the run has finished (``model.zip``): it is not resumed, and a
-                snapshot would drop the older checkpoints that choosing one by validation reads.
+            FileExistsError: the run has finished (``model.zip``) and no ``chosen`` checkpoint is
+                given: a snapshot would drop the older checkpoints that choosing one reads.
         """
         if isinstance(keep, bool) or not isinstance(keep, int) or keep < 1:
             raise ValueError(f"keep: {keep!r} is not a whole number of checkpoints >= 1")
-        if self.model_file.is_file():
+        finished = self.model_file.is_file()
+        if finished and chosen is None:
             raise FileExistsError(
                 f"{self.path}: finished (model.zip), nothing to resume; a snapshot keeps only the newest checkpoints, "
-                "so validate and export the run (zoo/finish_paper_run.sh) while its checkpoints are there")
+                "so validate and export the run (zoo/finish_paper_run.sh) while its checkpoints are there, "
+                "or pass the checkpoint validation chose (chosen=)")
         valid = [p for p in reversed(self.checkpoints()) if is_valid_model_file(p)]     # newest first
+        chosen_model = chosen is not None and finished and Path(chosen).resolve() == self.model_file.resolve()
+        if chosen is not None and not chosen_model and Path(chosen).resolve() not in {p.resolve() for p in valid}:
+            raise ValueError(f"chosen: {chosen} is not a valid checkpoint of {self.path}")
         if not valid:
             raise FileNotFoundError(f"{self.path}: no valid checkpoint to snapshot")
-        wanted = {int(m) for m in milestones}
-        kept = valid[:keep] + [p for p in valid[keep:] if model_steps(p) in wanted]
+        wanted = {int(m) for m in milestones} | ({model_steps(chosen)} if chosen and not chosen_model else set())
+        newest = [] if finished else valid[:keep]
+        kept = newest + [p for p in valid if p not in newest and model_steps(p) in wanted]
         # a run that normalises its rewards is resumed with the statistics beside its checkpoint
         normalized = not self.config_file.is_file() or bool(
             (self.read_config().get("hyperparams") or {}).get("normalize_reward", True))
@@ -433,10 +446,15 @@ class RunFolder:
             shutil.copy2(source, target.checkpoints_dir / source.name)
             if source.suffix == ".zip":      # no path of this machine travels inside a checkpoint
                 relative_tensorboard_log(target.checkpoints_dir / source.name, recorded_path(self.tensorboard_dir))
-        for name in (self.CONFIG, self.COMMAND) + self.RECORDS:
+        names = (self.MODEL,) if finished else ()
+        for name in names + (self.CONFIG, self.COMMAND) + self.RECORDS:
             if (self.path / name).is_file():
                 shutil.copy2(self.path / name, target.path / name)
-        return target.checkpoints_dir / kept[0].name
+        if finished:
+            relative_tensorboard_log(target.model_file, recorded_path(self.tensorboard_dir))
+        if not kept:            # a finished run whose final model validation chose, no milestones
+            return target.model_file
+        return target.checkpoints_dir / max(kept, key=model_steps).name
 
     # -- config and command --------------------------------------------------------------------
     def read_config(self) -> dict:

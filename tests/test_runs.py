@@ -110,6 +110,34 @@ def test_a_finished_run_is_not_snapshot_since_the_snapshot_would_drop_its_checkp
     assert not (tmp_path / "finished").exists()                     # refused before any copy
 
 
+def test_a_finished_run_is_snapshot_with_its_final_model_and_the_checkpoint_validation_chose(tmp_path):
+    import zipfile
+    run = _stopped_run(tmp_path / "run", steps=(400, 800, 1200, 1600))
+    run.config_file.write_text("map: A\n")
+    run.curve_file.write_text("timesteps\n1600\n")
+    with zipfile.ZipFile(run.model_file, "w") as archive:           # the run finishes at 1,700
+        archive.writestr("data", '{"num_timesteps": 1700}')
+    copied = run.snapshot(tmp_path / "snap", chosen=run.checkpoint_file(800), milestones=(400,))
+    snap = RunFolder(tmp_path / "snap")
+    assert copied == snap.checkpoint_file(800)
+    assert [p.name for p in snap.checkpoints()] == ["model_400_steps.zip", "model_800_steps.zip"]   # not the newest
+    assert snap.statistics_file(800).read_bytes() == b"stats 800"
+    assert snap.model_file.read_bytes() == run.model_file.read_bytes()
+    assert sorted(p.name for p in snap.path.iterdir()) == ["checkpoints", "config.yml", "curve.csv", "model.zip"]
+    assert run.snapshot(tmp_path / "final", chosen=run.model_file) == RunFolder(tmp_path / "final").model_file
+    assert RunFolder(tmp_path / "final").checkpoints() == []        # the final model chosen: no checkpoint needed
+    run.checkpoint_file(1200).write_bytes(b"")                      # cut: not a checkpoint validation could choose
+    for bad in (run.checkpoint_file(1200), run.checkpoint_file(5000), tmp_path / "elsewhere" / "model.zip"):
+        with pytest.raises(ValueError, match="chosen: .* is not a valid checkpoint of"):
+            run.snapshot(tmp_path / "bad", chosen=bad)
+    assert not (tmp_path / "bad").exists()                          # refused before any copy
+    stopped = _stopped_run(tmp_path / "stopped", steps=(400, 800, 1200))
+    kept = RunFolder(tmp_path / "snap_stopped")
+    stopped.snapshot(kept.path, chosen=stopped.checkpoint_file(400))   # a stopped run: the newest, and the chosen one
+    assert [p.name for p in kept.checkpoints()] == ["model_400_steps.zip", "model_1200_steps.zip"]
+    assert not kept.model_file.exists()
+
+
 def test_config_is_written_and_read_through_the_schema(tmp_path):
     run = RunFolder(tmp_path)
     run.write_config({"map": "A", "seed": 3})

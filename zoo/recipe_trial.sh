@@ -3,6 +3,11 @@
 # finished, in the order the rule (docs/experiments/2026-12-07-afternoon.md, written before any
 # result) demands. Run from the repository root, one step at a time:
 #
+#   zoo/recipe_trial.sh validate E1|E2   # as soon as one recipe's three runs have finished: validate
+#                                 #   them (seed 7), keep their rule figures in RULE_JSON and a
+#                                 #   snapshot of each finished run (model.zip, the checkpoint chosen,
+#                                 #   E2's milestones) in zoo/in_progress/, so that the others can take
+#                                 #   sessions more; nothing is chosen, exported or evaluated on seed 0
 #   zoo/recipe_trial.sh choose    # validate E1's and E2's runs (seed 7), apply the rule: RULE_JSON
 #   zoo/recipe_trial.sh shelve    # only after 'choose': E1 onto zoo/cd10/, E2 onto zoo/paper-recipe/,
 #                                 #   each with its 24 h eval.json (seed 0), listening and ablation
@@ -14,15 +19,25 @@
 # runs/e2/A/rl-msg/seed<k> (patrolsb3 sweep zoo/sweeps/paper-recipe-a.yml); E0: the zoo's
 # A/rl-msg seeds. RULE_JSON (default zoo/comparison-recipes/recipe_rule.json) keeps every
 # model's rule figures; it starts from E0's (2026-12-07-night-logs/recipe_rule_E0.json), so E0 is
-# not played again. Logs go to runs/recipe_trial/.
+# not played again. Each run's validation (`zoo validate --last 6`) is kept beside RULE_JSON
+# (validate_<e1|e2>_seed<k>.txt, committed), so a run restored from its snapshot is not validated
+# twice. Other logs go to runs/recipe_trial/.
 set -euo pipefail
-STEP=${1:?usage: zoo/recipe_trial.sh choose|shelve|budget|compare}
+USAGE="usage: zoo/recipe_trial.sh validate E1|E2 | choose | shelve | budget | compare"
+STEP=${1:?$USAGE}
 SEEDS=(0 1 2)
 E1_RUNS=runs/e1/stage2/A/rl-msg
 E2_RUNS=runs/e2/A/rl-msg
+E2_MILESTONES="16000000,32000000"      # E2's checkpoints at the zoo's budget and 3.2 M episode steps
 LOG=runs/recipe_trial
 RULE_JSON=${RULE_JSON:-zoo/comparison-recipes/recipe_rule.json}
-mkdir -p "$LOG"
+VALIDATIONS=$(dirname "$RULE_JSON")
+RULE=docs/experiments/2026-12-07-evening-scripts/recipe_rule.py
+
+start_rule_json() {   # RULE_JSON begins with E0's figures (validation seed 7), computed once
+  mkdir -p "$LOG" "$VALIDATIONS"
+  [ -f "$RULE_JSON" ] || cp docs/experiments/2026-12-07-night-logs/recipe_rule_E0.json "$RULE_JSON"
+}
 
 finished() {   # every seed of a recipe has its model.zip
   local runs=$1 k
@@ -35,11 +50,12 @@ finished() {   # every seed of a recipe has its model.zip
 }
 
 best_of() {    # the checkpoint 'zoo validate --last 6' chose for one run (validated once)
-  local run=$1 tag=$2
-  if [ ! -s "$LOG/validate_$tag.txt" ]; then
-    patrolsb3 zoo validate "$run" --last 6 > "$LOG/validate_$tag.txt" 2>&1
+  local run=$1 tag=$2 record="$VALIDATIONS/validate_$2.txt"
+  if ! grep -q '^best: ' "$record" 2>/dev/null; then
+    patrolsb3 zoo validate "$run" --last 6 > "$record.partial" 2>&1
+    mv "$record.partial" "$record"
   fi
-  sed -n 's/^best: //p' "$LOG/validate_$tag.txt"
+  sed -n 's/^best: //p' "$record"
 }
 
 chosen() {     # the recipe the rule chose, from RULE_JSON; empty before 'choose'
@@ -47,17 +63,39 @@ chosen() {     # the recipe the rule chose, from RULE_JSON; empty before 'choose
 }
 
 case "$STEP" in
+  validate)
+    case "${2:-}" in
+      E1) runs=$E1_RUNS; tag=e1; milestones="" ;;
+      E2) runs=$E2_RUNS; tag=e2; milestones=$E2_MILESTONES ;;
+      *) echo "recipe_trial.sh: validate takes E1 or E2, not '${2:-}' ($USAGE)" >&2; exit 2 ;;
+    esac
+    finished "$runs"
+    start_rule_json
+    models=()
+    for k in "${SEEDS[@]}"; do
+      models+=("$(best_of "$runs/seed$k" "${tag}_seed$k")")
+    done
+    python "$RULE" "$2=$(IFS=,; echo "${models[*]}")" --json "$RULE_JSON" | tee "$LOG/rule_$tag.txt"
+    for k in "${SEEDS[@]}"; do    # the finished run, kept for 'shelve' and 'budget' on any machine
+      python -c "
+import sys
+from patrolsb3.runs import RunFolder
+milestones = [int(m) for m in sys.argv[4].split(',') if m]
+print(RunFolder(sys.argv[1]).snapshot(sys.argv[2], chosen=sys.argv[3], milestones=milestones))" \
+        "$runs/seed$k" "zoo/in_progress/${runs#runs/}/seed$k" "${models[$k]}" "$milestones"
+    done
+    echo "kept: zoo/in_progress/${runs#runs/}/seed{0,1,2} (restore with cp -r into $runs/), $RULE_JSON, $VALIDATIONS/validate_${tag}_seed*.txt"
+    ;;
   choose)
     finished "$E1_RUNS"; finished "$E2_RUNS"
+    start_rule_json
     e0=$(IFS=,; echo "${SEEDS[*]/#/zoo/A/rl-msg/seed}")
     e1=(); e2=()
     for k in "${SEEDS[@]}"; do
       e1+=("$(best_of "$E1_RUNS/seed$k" "e1_seed$k")")
       e2+=("$(best_of "$E2_RUNS/seed$k" "e2_seed$k")")
     done
-    mkdir -p "$(dirname "$RULE_JSON")"
-    [ -f "$RULE_JSON" ] || cp docs/experiments/2026-12-07-night-logs/recipe_rule_E0.json "$RULE_JSON"
-    python docs/experiments/2026-12-07-evening-scripts/recipe_rule.py "E0=$e0" \
+    python "$RULE" "E0=$e0" \
       "E1=$(IFS=,; echo "${e1[*]}")" "E2=$(IFS=,; echo "${e2[*]}")" --json "$RULE_JSON" | tee "$LOG/rule.txt"
     ;;
   shelve)
@@ -80,7 +118,8 @@ case "$STEP" in
       echo "recipe_trial.sh: no choice in $RULE_JSON yet; run 'zoo/recipe_trial.sh choose' first (no seed-0 evaluation before the rule)" >&2
       exit 2
     fi
-    for steps in 16000000 32000000; do
+    mkdir -p "$LOG"
+    for steps in ${E2_MILESTONES//,/ }; do
       for k in "${SEEDS[@]}"; do
         checkpoint="$E2_RUNS/seed$k/checkpoints/model_${steps}_steps.zip"
         if [ ! -f "$checkpoint" ]; then
@@ -98,6 +137,7 @@ case "$STEP" in
       echo "recipe_trial.sh: no choice in $RULE_JSON yet; run 'zoo/recipe_trial.sh choose' first" >&2
       exit 2
     fi
+    mkdir -p "$LOG"
     patrolsb3 compare --maps A --agents 1-5 --episodes 10 --steps 14400 --out zoo/comparison-recipes \
       --strategies CR,PART,SEBS,zoo:rl-msg,zoo:rl-msg:cd10,zoo:rl-msg:paper-recipe --no-progress \
       > "$LOG/compare.txt" 2>&1
@@ -109,7 +149,7 @@ case "$STEP" in
     echo "zoo/comparison-recipes: report.md, claims.md (E0), claims-cd10.md (E1), claims-paper-recipe.md (E2)"
     ;;
   *)
-    echo "usage: zoo/recipe_trial.sh choose|shelve|budget|compare" >&2
+    echo "recipe_trial.sh: no step '$STEP' ($USAGE)" >&2
     exit 2
     ;;
 esac

@@ -6,7 +6,9 @@ candidate models of each recipe, on the validation seed only.
         E1=PATH,PATH,PATH E2=PATH,PATH,PATH [--steps 14400] [--episodes 10] [--json FILE]
 
 With ``--json FILE``, a model whose figures FILE already holds for the same episodes and steps is
-not played again (E0's figures, computed once, serve when E1 and E2 come in).
+not played again (E0's figures, computed once, serve when E1 and E2 come in), and FILE keeps the
+figures of every model it held, named in this call or not: one recipe's figures can be added as
+soon as its runs finish (``zoo/recipe_trial.sh validate E1``), the choice made when all are in.
 
 Each PATH is a zoo entry folder or a checkpoint (``<run>/checkpoints/model_<k>_steps.zip``, the one
 ``zoo validate RUN --last 6`` picked). Every candidate plays ``--episodes`` greedy episodes per team
@@ -75,6 +77,7 @@ def main() -> None:
     known = {}
     if args.json and Path(args.json).is_file():
         known = {(r["model"], r.get("episodes"), r.get("steps")): r for r in json.loads(Path(args.json).read_text())["seeds"]}
+    kept_rows = dict(known)       # FILE keeps the figures of models not named in this call (E1's before E2's)
     figure_names = ("bf_rate_3_5", "collisions_3_5", "avg_idleness_1_5")
     for item in args.recipes:
         name, _, paths = item.partition("=")
@@ -85,11 +88,12 @@ def main() -> None:
                        else candidate_figures(Path(path), args.episodes, args.steps))
             per_seed.append(figures)
             rows.append({"recipe": name, "model": path, "episodes": args.episodes, "steps": args.steps, **figures})
+            kept_rows[(path, args.episodes, args.steps)] = rows[-1]
             print(f"{name} {path}: " + ", ".join(f"{k} {v:.3f}" for k, v in figures.items()), flush=True)
         recipes[name] = {k: float(np.mean([f[k] for f in per_seed])) for k in per_seed[0]}
         seeds[name] = len(per_seed)
     if args.json:     # every model's figures kept at once, before the choice
-        Path(args.json).write_text(json.dumps({"seeds": rows}, indent=2))
+        Path(args.json).write_text(json.dumps({"seeds": list(kept_rows.values())}, indent=2))
     for name, f in recipes.items():
         print(f"{name} (mean of {seeds[name]} seeds): " + ", ".join(f"{k} {v:.3f}" for k, v in f.items()))
     if len(recipes) < 2:      # figures of one recipe, kept for later: nothing to choose between yet
@@ -98,7 +102,8 @@ def main() -> None:
     chosen, why = choose(recipes)
     print(f"chosen: {chosen} ({why})")
     if args.json:
-        Path(args.json).write_text(json.dumps({"seeds": rows, "recipes": recipes, "chosen": chosen, "why": why},
+        Path(args.json).write_text(json.dumps({"seeds": list(kept_rows.values()), "recipes": recipes,
+                                               "chosen": chosen, "why": why},
                                               indent=2))
 
 
