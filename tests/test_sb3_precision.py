@@ -148,6 +148,27 @@ def test_a_bf16_run_resumed_without_native_bf16_goes_on_in_fp32_and_says_from_wh
     train(map=ROOM, timesteps=400, out=tmp_path / "explicit", hyperparams=tiny_hp(precision="bf16"), progress_bar=False)
     assert "this CPU has no native bf16, so torch emulates it" in capsys.readouterr().err
     assert precision_module.resumed_precision("bf16", "bf16") == ("bf16", "")
+
+
+def test_a_run_that_went_on_in_fp32_for_want_of_native_bf16_goes_back_to_bf16_where_it_is_native(
+        tmp_path, capsys, monkeypatch):
+    native = {"name": "x", "native_bf16": True, "bf16_flags": ["avx512_bf16"]}
+    monkeypatch.setattr(precision_module, "cpu_info", lambda: native)
+    run = train(map=ROOM, timesteps=400, out=tmp_path, hyperparams=tiny_hp(precision="auto"), progress_bar=False)
+    monkeypatch.setattr(precision_module, "cpu_info", lambda: {**native, "native_bf16": False, "bf16_flags": []})
+    train(map=ROOM, timesteps=800, out=tmp_path, hyperparams=tiny_hp(precision="auto"), resume=True, progress_bar=False)
+    monkeypatch.setattr(precision_module, "cpu_info", lambda: native)       # a machine with native bf16 again
+    capsys.readouterr()
+    train(map=ROOM, timesteps=1200, out=tmp_path, hyperparams=tiny_hp(precision="fp32"), resume=True,
+          progress_bar=False)                                                # fp32 asked for: stays fp32
+    assert "goes on in" not in capsys.readouterr().err
+    train(map=ROOM, timesteps=1600, out=tmp_path, hyperparams=tiny_hp(precision="auto"), resume=True, progress_bar=False)
+    assert "was trained in fp32 so far and goes on in bf16: this machine has native bf16" in capsys.readouterr().err
+    changes = RunFolder(run).read_config()["precision_changes"]
+    assert [(c["timesteps"], c["precision"]) for c in changes] == [(400, "fp32"), (1200, "bf16")]
+    # a run that started in fp32 stays fp32 on any machine
+    assert precision_module.resumed_precision("fp32", "auto", started="fp32") == ("fp32", "")
+    assert precision_module.resumed_precision("fp32", "auto", started="bf16")[0] == "bf16"
     assert precision_module.resumed_precision("fp32", "auto") == ("fp32", "")
     # a resume from a checkpoint before the change drops it (the stretch after it is gone)
     RunFolder(run).cut_back_to(400)

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import contextlib
 import platform
+import sys
 from functools import lru_cache
 from pathlib import Path
 
@@ -70,26 +71,44 @@ def resolve_precision(precision: str, device: str = "cpu") -> str:
     return precision
 
 
-def resumed_precision(recorded: str, asked: str, device: str = "cpu") -> tuple[str, str]:
+def resumed_precision(recorded: str, asked: str, device: str = "cpu", started: str | None = None) -> tuple[str, str]:
     """The precision a resumed run goes on in, and why it changed ("" when it did not).
 
-    A run keeps the precision it recorded, with one exception: a bf16 run resumed where bf16 is
-    not native (a CPU without ``avx512_bf16`` / ``amx_bf16`` / Arm ``bf16``) goes on in fp32
-    unless ``bf16`` is asked for explicitly. Emulated bf16 is several times slower than fp32 (on
-    an AMD EPYC without AVX512-BF16, one rollout and update of issue 43's E2 took more than 415
-    CPU seconds in emulated bf16, against 160-200 in fp32), and bf16 and fp32 learn alike
-    (docs/training.md, "Precision").
+    A run keeps the precision it trained with last, with two exceptions that follow the machine
+    (bf16 and fp32 learn alike: docs/training.md, "Precision"):
+
+    * a bf16 run resumed where bf16 is not native (a CPU without ``avx512_bf16`` /
+      ``amx_bf16`` / Arm ``bf16``) goes on in fp32 unless ``bf16`` is asked for explicitly.
+      Emulated bf16 is several times slower than fp32 (on an AMD EPYC without AVX512-BF16, one
+      rollout and update of issue 43's E2 took more than 415 CPU seconds in emulated bf16,
+      against 160-200 in fp32);
+    * a run that started in bf16 and went on in fp32 for that reason goes back to bf16 where
+      bf16 is native again, unless ``fp32`` is asked for explicitly (on an AMD EPYC with
+      AVX512-BF16, bf16 halves the update: docs/benchmarks.md).
 
     Args:
-        recorded: the precision in the run's config.yml (``fp32`` or ``bf16``).
+        recorded: the precision the run trained with last (config.yml: its hyperparams'
+            ``precision``, or the latest ``precision_changes`` entry).
         asked: this call's ``precision`` hyperparameter (``auto``, ``fp32`` or ``bf16``).
         device: the torch device type the networks train on.
+        started: the precision the run started with (config.yml's hyperparams), None if unknown.
     """
     device = str(device).split(":")[0]
     native = device == "cuda" or cpu_info()["native_bf16"]
     if recorded == "bf16" and not native and asked != "bf16":
         return "fp32", "this machine has no native bf16 (emulated bf16 is several times slower; bf16 and fp32 learn alike)"
+    if recorded == "fp32" and started == "bf16" and native and asked != "fp32":
+        return "bf16", "this machine has native bf16: back to the bf16 the run started in (bf16 and fp32 learn alike)"
     return recorded, ""
+
+
+def warned_if_emulated(precision: str, device_type: str) -> str:
+    """``precision``, after a note on stderr when it is bf16 on a CPU without native bf16 (asked
+    for explicitly: torch emulates it, several times slower than fp32)."""
+    if precision == "bf16" and str(device_type).startswith("cpu") and not cpu_info()["native_bf16"]:
+        print("precision bf16: this CPU has no native bf16, so torch emulates it, several times slower "
+              "than fp32 (precision auto picks fp32 here)", file=sys.stderr)
+    return precision
 
 
 def autocast(precision: str, device_type: str):

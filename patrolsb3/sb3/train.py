@@ -30,7 +30,7 @@ from .cpu_time import CpuTimeCallback, cpu_hours_of, read_rows, restart_at
 from .curriculum import CURRICULUM, CurriculumCallback
 from .hyperparams import load_hyperparams, merge, per_phase, schedule
 from .policy import policy_kwargs_for
-from .precision import PRECISIONS, cpu_info, resolve_precision, resumed_precision
+from .precision import PRECISIONS, resolve_precision, resumed_precision, warned_if_emulated
 from .variants import variant_overrides
 from .vec_env import DEFAULT_AGENTS, make_vec_env, training_config
 
@@ -327,9 +327,9 @@ def run_precision(hp: dict, device_type: str, resumed: RunFolder | None = None,
     A new run: its ``precision`` hyperparameter resolved on this device
     (:func:`patrolsb3.sb3.precision.resolve_precision`). A resumed run keeps the one its
     config.yml records (``fp32`` when it records none: runs from before the setting existed) and
-    says so on stderr when the hyperparameters asked for another, except a bf16 run on a machine
-    without native bf16, which goes on in fp32
-    (:func:`patrolsb3.sb3.precision.resumed_precision`); config.yml records such a change, and
+    says so on stderr when the hyperparameters asked for another, except where the machine
+    decides (:func:`patrolsb3.sb3.precision.resumed_precision`: a bf16 run without native bf16
+    goes on in fp32, and back to bf16 where it is native again); config.yml records such a change, and
     the run's precision at ``at_timesteps`` (the checkpoint it resumes from) is the latest change
     before it.
 
@@ -341,11 +341,12 @@ def run_precision(hp: dict, device_type: str, resumed: RunFolder | None = None,
     if resumed is None or not resumed.config_file.is_file():
         return warned_if_emulated(wanted, device_type), ""
     recorded = resumed.read_config()
-    kept = (recorded.get("hyperparams") or {}).get("precision", "fp32")
+    started = (recorded.get("hyperparams") or {}).get("precision", "fp32")
+    kept = started
     for change in recorded.get("precision_changes") or []:       # the latest change before the checkpoint
         if change["timesteps"] < max(at_timesteps, 1):
             kept = change["precision"]
-    used, why = resumed_precision(kept, asked, device_type)
+    used, why = resumed_precision(kept, asked, device_type, started=started)
     if why:
         print(f"--resume: {resumed.path} was trained in {kept} so far and goes on in {used}: {why}; "
               f"config.yml records the change (precision_changes)", file=sys.stderr)
@@ -353,15 +354,6 @@ def run_precision(hp: dict, device_type: str, resumed: RunFolder | None = None,
         print(f"--resume: {resumed.path} keeps the precision it was trained with ({used}), not {wanted}",
               file=sys.stderr)
     return warned_if_emulated(used, device_type), why
-
-
-def warned_if_emulated(precision: str, device_type: str) -> str:
-    """``precision``, after a note on stderr when it is bf16 on a CPU without native bf16 (asked
-    for explicitly: torch emulates it, several times slower than fp32)."""
-    if precision == "bf16" and str(device_type).startswith("cpu") and not cpu_info()["native_bf16"]:
-        print("precision bf16: this CPU has no native bf16, so torch emulates it, several times slower "
-              "than fp32 (precision auto picks fp32 here)", file=sys.stderr)
-    return precision
 
 
 def mixed_episodes(hp: dict, n_episodes: int) -> dict:
