@@ -11,8 +11,9 @@
 #   zoo/recipe_trial.sh choose    # validate E1's and E2's runs (seed 7), apply the rule: RULE_JSON
 #   zoo/recipe_trial.sh shelve    # only after 'choose': E1 onto zoo/cd10/, E2 onto zoo/paper-recipe/,
 #                                 #   each with its 24 h eval.json (seed 0), listening and ablation
-#   zoo/recipe_trial.sh budget    # E2's checkpoints at 16 M and 32 M agent-steps (1.6 M and 3.2 M
-#                                 #   episode steps), evaluated like an entry, in a scratch zoo
+#   zoo/recipe_trial.sh budget    # after 'shelve': E2's checkpoints at 16 M and 32 M agent-steps (1.6 M
+#                                 #   and 3.2 M episode steps) evaluated like an entry (scratch zoo),
+#                                 #   beside the full budget: zoo/comparison-recipes/budget.md
 #   zoo/recipe_trial.sh compare   # E0, E1, E2 beside CR, PART, SEBS on A, and the claims of each
 #
 # E1: runs/e1/stage2/A/rl-msg/seed<k> (zoo/train_paper_setting.sh with env.c_d=10); E2:
@@ -118,19 +119,32 @@ print(RunFolder(sys.argv[1]).snapshot(sys.argv[2], chosen=sys.argv[3], milestone
       echo "recipe_trial.sh: no choice in $RULE_JSON yet; run 'zoo/recipe_trial.sh choose' first (no seed-0 evaluation before the rule)" >&2
       exit 2
     fi
-    mkdir -p "$LOG"
-    for steps in ${E2_MILESTONES//,/ }; do
-      for k in "${SEEDS[@]}"; do
-        checkpoint="$E2_RUNS/seed$k/checkpoints/model_${steps}_steps.zip"
-        if [ ! -f "$checkpoint" ]; then
-          echo "recipe_trial.sh: $checkpoint is missing (snapshots keep it as a milestone)" >&2
+    for k in "${SEEDS[@]}"; do
+      if [ ! -f "zoo/paper-recipe/A/rl-msg/seed$k/eval.json" ]; then
+        echo "recipe_trial.sh: zoo/paper-recipe/A/rl-msg/seed$k/eval.json is missing (E2 at its full budget); run 'zoo/recipe_trial.sh shelve' first" >&2
+        exit 2
+      fi
+      for steps in ${E2_MILESTONES//,/ }; do
+        if [ ! -f "$E2_RUNS/seed$k/checkpoints/model_${steps}_steps.zip" ]; then
+          echo "recipe_trial.sh: $E2_RUNS/seed$k/checkpoints/model_${steps}_steps.zip is missing (snapshots keep it as a milestone)" >&2
           exit 2
         fi
-        patrolsb3 zoo export "$E2_RUNS/seed$k" --checkpoint "$checkpoint" --shelf paper-recipe \
-          --zoo-dir "$LOG/budget-$steps" > "$LOG/budget_${steps}_seed$k.txt" 2>&1
       done
-      echo "E2 at $steps agent-steps: $LOG/budget-$steps/paper-recipe/A/rl-msg/seed*/eval.json"
     done
+    mkdir -p "$LOG"
+    rows=()
+    for steps in ${E2_MILESTONES//,/ }; do
+      for k in "${SEEDS[@]}"; do     # exported into a scratch zoo; its 24-h eval.json is kept
+        patrolsb3 zoo export "$E2_RUNS/seed$k" --checkpoint "$E2_RUNS/seed$k/checkpoints/model_${steps}_steps.zip" \
+          --shelf paper-recipe --zoo-dir "$LOG/budget-$steps" > "$LOG/budget_${steps}_seed$k.txt" 2>&1
+        mkdir -p "$VALIDATIONS/budget/$steps/seed$k"
+        cp "$LOG/budget-$steps/paper-recipe/A/rl-msg/seed$k/eval.json" "$VALIDATIONS/budget/$steps/seed$k/eval.json"
+      done
+      rows+=("$steps=$VALIDATIONS/budget/$steps")
+    done
+    python docs/experiments/2026-12-08-scripts/budget_table.py "${rows[@]}" 75000000=zoo/paper-recipe/A/rl-msg \
+      --out "$VALIDATIONS/budget.md"
+    echo "E2 at each budget: $VALIDATIONS/budget.md (the evaluations in $VALIDATIONS/budget/<steps>/seed<k>/eval.json)"
     ;;
   compare)
     if [ -z "$(chosen)" ]; then
